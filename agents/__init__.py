@@ -1,0 +1,1 @@
+"""digslam.agents: coverage-planning baselines, training, evaluation and the command line."""

@@ -1,0 +1,30 @@
+"""digslam.observer: the thesis's interval library and the guaranteed Dig-SLAM observer.
+
+Intervals and boxes (:class:`IntervalArray`, :func:`Interval`, :func:`Box`), functions and their
+natural inclusion (:class:`Function`), contractors (:class:`CtcFwdBwd` and the algebra), all acting on
+batches of boxes: two float64 arrays ``lo, hi`` of shape ``(N, n)``.
+"""
+
+from . import arith, boxes, rounding, trig
+from .contractors import Ctc, CtcCompose, CtcFixPoint, CtcFwdBwd, CtcInter, CtcUnion
+from .expr import Expr, Function
+from .interval import Box, Interval, IntervalArray, dot
+from .ops import abs_, acos, asin, atan, atan2, cos, exp, log, maximum, minimum, pown, sin, sqr, sqrt, tan
+from .paver import Paving, PavingTree, classify_grid, pave
+from .sep_inverse import SepInverse
+from .separators import Sep, SepBox, SepInter, SepNot, SepQInter, SepUnion
+from .sep_image import CtcImage, SepImage
+from .sep_polygon import CtcPolygonBoundary, CtcSegments, SepPolygon
+from .subpaving import SepSubpaving, load, save, simplify
+
+__all__ = [
+    "arith", "boxes", "rounding", "trig",
+    "Ctc", "CtcCompose", "CtcFixPoint", "CtcFwdBwd", "CtcInter", "CtcUnion",
+    "Paving", "PavingTree", "classify_grid", "pave", "SepInverse",
+    "CtcImage", "SepImage", "CtcPolygonBoundary", "CtcSegments", "SepPolygon",
+    "SepSubpaving", "load", "save", "simplify",
+    "Sep", "SepBox", "SepInter", "SepNot", "SepQInter", "SepUnion",
+    "Expr", "Function", "Box", "Interval", "IntervalArray", "dot",
+    "abs_", "acos", "asin", "atan", "atan2", "cos", "exp", "log", "maximum", "minimum", "pown", "sin",
+    "sqr", "sqrt", "tan",
+]  # fmt: skip

@@ -1,0 +1,210 @@
+"""Separators on batches and their algebra (thesis §2.4.2, Eq. 2.46–2.54).
+
+A separator for a set ``X`` maps a batch ``[x]`` to two batches ``([x_in], [x_out])`` with
+``[x_in] ∪ [x_out] = [x]``: ``[x] \\ [x_in]`` is proved inside ``X`` and ``[x] \\ [x_out]`` proved
+outside (``x_in`` keeps the complement, ``x_out`` keeps the set). ``~S`` swaps them (Eq. 2.53),
+``S₁ & S₂`` and ``S₁ | S₂`` follow Eq. 2.54, ``S₁ - S₂ = S₁ & ~S₂``, and :class:`SepQInter` is the
+q-relaxed intersection.
+
+>>> import numpy as np
+>>> s = SepBox(Box([(0, 1), (0, 1)])) & ~SepBox(Box([(0.5, 2), (0.5, 2)]))   # an L shape
+>>> xin, xout = s(Box([(0.6, 0.9), (0.6, 0.9)]))
+>>> bool(xout.is_empty().any()), bool(xin.is_empty().any())                 # proved outside
+(True, False)
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .boxes import empty_rows, normalize_empty, validate_batch
+from .interval import IntervalArray, as_pair
+
+Batch = tuple[np.ndarray, np.ndarray]
+
+
+class Sep:
+    """Base class: subclasses implement :meth:`separate` on raw ``(N, n)`` batches."""
+
+    #: input dimension, or None when any dimension goes
+    n: int | None = None
+
+    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        """Return ``((in_lo, in_hi), (out_lo, out_hi))``; inputs are not modified."""
+        raise NotImplementedError(f"{type(self).__name__}.separate")
+
+    def __call__(self, boxes: IntervalArray | tuple[Any, Any]) -> tuple[Any, Any]:
+        """Separate an :class:`IntervalArray` box ``(n,)`` / batch ``(N, n)``, or a ``(lo, hi)`` pair."""
+        is_ia = isinstance(boxes, IntervalArray)
+        lo, hi = boxes.pair if is_ia else boxes
+        single = np.ndim(lo) == 1
+        lo, hi = validate_batch(lo, hi, "boxes", self.n)
+        res = []
+        for b in self.separate(lo, hi):
+            blo, bhi = normalize_empty(*b)
+            if single:
+                blo, bhi = blo[0], bhi[0]
+            res.append(IntervalArray._raw(blo, bhi) if is_ia else (blo, bhi))
+        return res[0], res[1]
+
+    def __invert__(self) -> Sep:
+        return SepNot(self)
+
+    def __and__(self, other: Sep) -> Sep:
+        return SepInter(self, other)
+
+    def __or__(self, other: Sep) -> Sep:
+        return SepUnion(self, other)
+
+    def __sub__(self, other: Sep) -> Sep:
+        return SepInter(self, SepNot(other))
+
+
+def _dim(seps: tuple[Sep, ...]) -> int | None:
+    dims = {s.n for s in seps if s.n is not None}
+    if len(dims) > 1:
+        raise ValueError(f"separators: mismatched dimensions {sorted(dims)}")
+    return dims.pop() if dims else None
+
+
+def inter_batch(a: Batch, b: Batch) -> Batch:
+    """Row-wise intersection of two batches (empty rows normalised)."""
+    return normalize_empty(np.maximum(a[0], b[0]), np.minimum(a[1], b[1]))
+
+
+def hull_batch(a: Batch, b: Batch) -> Batch:
+    """Row-wise hull of two batches whose empty rows are ``[+inf, -inf]``."""
+    return np.minimum(a[0], b[0]), np.maximum(a[1], b[1])
+
+
+class SepNot(Sep):
+    """Complement ``{S_out, S_in}`` (Eq. 2.53)."""
+
+    def __init__(self, sep: Sep) -> None:
+        self.sep, self.n = sep, sep.n
+
+    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        xin, xout = self.sep.separate(lo, hi)
+        return xout, xin
+
+    def __invert__(self) -> Sep:
+        return self.sep
+
+
+class SepInter(Sep):
+    """``S₁ ∩ … ∩ S_k = {⊔ S_iⁱⁿ, ∩ S_iᵒᵘᵗ}`` (Eq. 2.54)."""
+
+    def __init__(self, *seps: Sep) -> None:
+        self.seps, self.n = seps, _dim(seps)
+
+    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        xin = (np.full_like(lo, np.inf), np.full_like(hi, -np.inf))
+        xout = (lo, hi)
+        for s in self.seps:
+            i, o = s.separate(lo, hi)
+            xin, xout = hull_batch(xin, normalize_empty(*i)), inter_batch(xout, o)
+        return xin, xout
+
+
+class SepUnion(Sep):
+    """``S₁ ∪ … ∪ S_k = {∩ S_iⁱⁿ, ⊔ S_iᵒᵘᵗ}`` (Eq. 2.54)."""
+
+    def __init__(self, *seps: Sep) -> None:
+        self.seps, self.n = seps, _dim(seps)
+
+    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        xin, xout = SepInter(*(SepNot(s) for s in self.seps)).separate(lo, hi)
+        return xout, xin
+
+
+def relaxed_intersection(los: np.ndarray, his: np.ndarray, q: int) -> Batch:
+    """Hull of the points lying in at least ``m - q`` of ``m`` boxes, per coordinate.
+
+    Args:
+        los, his: ``(m, N, n)`` stacks of batches (empty rows ``[+inf, -inf]`` count for nothing).
+        q: number of boxes allowed to miss a point, ``0 <= q < m``.
+
+    Returns:
+        An ``(N, n)`` batch containing the q-relaxed intersection (coordinate-wise, so an outer
+        enclosure of the box relaxed intersection).
+    """
+    m = los.shape[0]
+    need = m - q
+    # a candidate lower bound c = los[j] is valid when #{i : los[i] <= c <= his[i]} >= need
+    inside_lo = (los[None] <= los[:, None]) & (los[:, None] <= his[None])  # (j, i, N, n)
+    cnt_lo = inside_lo.sum(axis=1)
+    lo = np.where(cnt_lo >= need, los, np.inf).min(axis=0)
+    inside_hi = (los[None] <= his[:, None]) & (his[:, None] <= his[None])
+    cnt_hi = inside_hi.sum(axis=1)
+    hi = np.where(cnt_hi >= need, his, -np.inf).max(axis=0)
+    return normalize_empty(lo, hi)
+
+
+class SepQInter(Sep):
+    """q-relaxed intersection of separators (Eq. 2.54): ``{S_iⁱⁿ (m-q-1)-relaxed, S_iᵒᵘᵗ q-relaxed}``.
+
+    The set is the points belonging to at least ``m - q`` of the ``m`` sets: robust to ``q`` outliers.
+    """
+
+    def __init__(self, seps: list[Sep], q: int) -> None:
+        if not seps:
+            raise ValueError("seps: need at least one separator")
+        if not 0 <= q < len(seps):
+            raise ValueError(f"q: must lie in [0, {len(seps)}) for {len(seps)} separators, got {q}")
+        self.seps, self.q, self.n = list(seps), int(q), _dim(tuple(seps))
+
+    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        parts = [s.separate(lo, hi) for s in self.seps]
+        m = len(parts)
+        ilo = np.stack([normalize_empty(*p[0])[0] for p in parts])
+        ihi = np.stack([normalize_empty(*p[0])[1] for p in parts])
+        olo = np.stack([normalize_empty(*p[1])[0] for p in parts])
+        ohi = np.stack([normalize_empty(*p[1])[1] for p in parts])
+        xout = relaxed_intersection(olo, ohi, self.q)
+        xin = relaxed_intersection(ilo, ihi, m - self.q - 1)
+        return inter_batch(xin, (lo, hi)), inter_batch(xout, (lo, hi))
+
+
+class SepBox(Sep):
+    """Separator of a box ``[y]``: ``x_out = [x] ∩ [y]``, ``x_in`` the hull of ``[x]`` minus ``[y]``."""
+
+    def __init__(self, box: Any) -> None:
+        ylo, yhi = as_pair(box, "box")
+        if np.ndim(ylo) == 0:
+            ylo, yhi = ylo[None], yhi[None]
+        if np.ndim(ylo) != 1 or np.any(ylo > yhi):
+            raise ValueError(f"box: expected one non-empty box (n,), got shape {np.shape(ylo)}")
+        self.box, self.n = (ylo, yhi), ylo.shape[0]
+
+    def pieces(self, lo: np.ndarray, hi: np.ndarray) -> list[Batch]:
+        """``[x] ∩ {y_k <= a_k}`` and ``[x] ∩ {y_k >= b_k}`` for every coordinate: the closed complement."""
+        out = []
+        for k in range(self.n):
+            for side in (0, 1):
+                plo, phi = lo.copy(), hi.copy()
+                if side == 0:
+                    phi[:, k] = np.minimum(hi[:, k], self.box[0][k])
+                else:
+                    plo[:, k] = np.maximum(lo[:, k], self.box[1][k])
+                out.append(normalize_empty(plo, phi))
+        return out
+
+    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        xout = inter_batch((lo, hi), (self.box[0][None], self.box[1][None]))
+        xin = (np.full_like(lo, np.inf), np.full_like(hi, -np.inf))
+        for p in self.pieces(lo, hi):
+            xin = hull_batch(xin, p)
+        # a box with no point outside [y] but touching its border stays in x_in only where it
+        # actually meets the closed complement; interior boxes get an empty x_in
+        return xin, xout
+
+
+def check_separation(xin: Batch, xout: Batch, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """``(N,)`` mask of rows where ``[x_in] ∪ [x_out]`` fails to be ``[x]`` (hull test; for tests)."""
+    h = hull_batch(normalize_empty(*xin), normalize_empty(*xout))
+    ok = empty_rows(lo, hi) | ((h[0] == lo).all(axis=1) & (h[1] == hi).all(axis=1))
+    sub = ((xin[0] >= lo) & (xin[1] <= hi)).all(axis=1) | empty_rows(*xin)
+    sub &= ((xout[0] >= lo) & (xout[1] <= hi)).all(axis=1) | empty_rows(*xout)
+    return ~(ok & sub)

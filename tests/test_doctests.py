@@ -1,0 +1,22 @@
+"""Run the docstring examples of every observer module (set operations are documented by example)."""
+
+from __future__ import annotations
+
+import doctest
+import importlib
+import pkgutil
+
+import numpy as np
+import pytest
+
+import digslam.observer as observer
+
+MODULES = sorted(m.name for m in pkgutil.iter_modules(observer.__path__) if not m.name.startswith("_"))
+
+
+@pytest.mark.parametrize("name", MODULES)
+def test_module_doctests(name: str) -> None:
+    mod = importlib.import_module(f"digslam.observer.{name}")
+    globs = {**vars(observer), "np": np}
+    res = doctest.testmod(mod, extraglobs=globs, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    assert res.failed == 0, f"{res.failed} doctest failures in digslam.observer.{name}"
