@@ -11,17 +11,19 @@ from .expr import Expr, Function
 from .interval import Box, Interval, IntervalArray, dot
 from .ops import abs_, acos, asin, atan, atan2, cos, exp, log, maximum, minimum, pown, sin, sqr, sqrt, tan
 from .paver import Paving, PavingTree, classify_grid, pave
-from .sep_inverse import SepInverse
-from .separators import Sep, SepBox, SepInter, SepNot, SepQInter, SepUnion
 from .sep_image import CtcImage, SepImage
+from .sep_inverse import SepInverse
 from .sep_polygon import CtcPolygonBoundary, CtcSegments, SepPolygon
+from .separators import Sep, SepBox, SepInter, SepNot, SepQInter, SepUnion
 from .subpaving import SepSubpaving, load, save, simplify
+from .transforms import CtcTransform, SepTransform, Transform, symmetric_union
 
 __all__ = [
     "arith", "boxes", "rounding", "trig",
     "Ctc", "CtcCompose", "CtcFixPoint", "CtcFwdBwd", "CtcInter", "CtcUnion",
     "Paving", "PavingTree", "classify_grid", "pave", "SepInverse",
     "CtcImage", "SepImage", "CtcPolygonBoundary", "CtcSegments", "SepPolygon",
+    "CtcTransform", "SepTransform", "Transform", "symmetric_union",
     "SepSubpaving", "load", "save", "simplify",
     "Sep", "SepBox", "SepInter", "SepNot", "SepQInter", "SepUnion",
     "Expr", "Function", "Box", "Interval", "IntervalArray", "dot",

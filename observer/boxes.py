@@ -157,3 +157,26 @@ def box_difference(
             rows.append(idx[keep])
         cur_lo[:, k], cur_hi[:, k] = ilo[:, k], ihi[:, k]
     return (np.concatenate(plos), np.concatenate(phis)), np.concatenate(rows)
+
+
+#: rows per block in :func:`chunked`: keeps a kernel's temporaries in cache
+CHUNK = 1 << 15
+
+
+def chunked(fn: Any, lo: np.ndarray, hi: np.ndarray) -> Any:
+    """``fn(lo, hi)`` applied block by block of :data:`CHUNK` rows, results concatenated.
+
+    ``fn`` returns an array or nested tuples of arrays whose first axis is the row. Large batches go
+    several times faster this way: each kernel's temporaries stay in cache instead of being freshly
+    allocated (and page-faulted) megabytes.
+    """
+    if lo.shape[0] <= CHUNK:
+        return fn(lo, hi)
+    parts = [fn(lo[i : i + CHUNK], hi[i : i + CHUNK]) for i in range(0, lo.shape[0], CHUNK)]
+
+    def cat(items: list[Any]) -> Any:
+        if isinstance(items[0], tuple):
+            return tuple(cat([it[k] for it in items]) for k in range(len(items[0])))
+        return np.concatenate(items)
+
+    return cat(parts)

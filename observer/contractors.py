@@ -19,7 +19,7 @@ import numpy as np
 
 from .arith import intersect
 from .backward import BACKWARD
-from .boxes import empty_rows, normalize_empty, validate_batch
+from .boxes import chunked, empty_rows, normalize_empty, validate_batch
 from .expr import Function
 from .interval import IntervalArray, as_pair
 
@@ -159,7 +159,7 @@ class CtcFwdBwd(Ctc):
         self.y = (ylo.astype(np.float64), yhi.astype(np.float64))
 
     def contract(self, lo: np.ndarray, hi: np.ndarray) -> Batch:
-        return hc4_backward(self.f, self.f.forward(lo, hi), self.y, lo, hi)
+        return chunked(lambda a, b: hc4_backward(self.f, self.f.forward(a, b), self.y, a, b), lo, hi)
 
 
 def hc4_backward(f: Function, vals: list[tuple[np.ndarray, np.ndarray]], y: Batch, lo: np.ndarray,

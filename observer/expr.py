@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from . import arith, trig
-from .boxes import validate_batch
+from .boxes import chunked, validate_batch
 from .interval import IntervalArray
 
 Pair = tuple[np.ndarray, np.ndarray]
@@ -246,17 +246,20 @@ class Function:
                 vals.append(FORWARD[op](p, *(vals[a] for a in args)))
         return vals
 
-    def eval(self, boxes: IntervalArray | Sequence[np.ndarray]) -> IntervalArray:
-        """Natural inclusion function ``[f]`` (Eq. 2.21) on a box ``(n,)`` or a batch ``(N, n)``."""
-        single = isinstance(boxes, IntervalArray) and boxes.ndim == 1
-        lo, hi = boxes.pair if isinstance(boxes, IntervalArray) else boxes
-        lo, hi = validate_batch(lo, hi, "boxes", self.n)
+    def _eval_batch(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         vals = self.forward(lo, hi)
         outs = [vals[o] for o in self.outputs]
         rlo = np.stack([np.broadcast_to(o[0], lo.shape[:1]) for o in outs], axis=-1)
         rhi = np.stack([np.broadcast_to(o[1], lo.shape[:1]) for o in outs], axis=-1)
         empty = (lo > hi).any(axis=-1)[:, None]
-        rlo, rhi = np.where(empty, np.inf, rlo), np.where(empty, -np.inf, rhi)
+        return np.where(empty, np.inf, rlo), np.where(empty, -np.inf, rhi)
+
+    def eval(self, boxes: IntervalArray | Sequence[np.ndarray]) -> IntervalArray:
+        """Natural inclusion function ``[f]`` (Eq. 2.21) on a box ``(n,)`` or a batch ``(N, n)``."""
+        single = isinstance(boxes, IntervalArray) and boxes.ndim == 1
+        lo, hi = boxes.pair if isinstance(boxes, IntervalArray) else boxes
+        lo, hi = validate_batch(lo, hi, "boxes", self.n)
+        rlo, rhi = chunked(self._eval_batch, lo, hi)
         if self.scalar_output:
             rlo, rhi = rlo[:, 0], rhi[:, 0]
         return IntervalArray._raw(rlo[0], rhi[0]) if single else IntervalArray._raw(rlo, rhi)

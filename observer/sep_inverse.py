@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from .boxes import chunked
 from .contractors import hc4_backward
 from .expr import Function
 from .separators import Batch, Sep, SepBox, hull_batch
@@ -53,6 +54,9 @@ class SepInverse(Sep):
         return ylo, yhi
 
     def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        return chunked(self._separate, lo, hi)
+
+    def _separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
         vals = self.f.forward(lo, hi)
         if self.box is None:
             assert self.sep_y is not None
