@@ -25,12 +25,12 @@ def problem(name: str):  # noqa: ANN201
     return Box([(-10, 10), (-10, 10)]), (s1 & s2) | (s3 & ~s1)  # Eq. 2.56
 
 
-def ours(name: str, eps: float, repeat: int) -> dict:
+def ours(name: str, eps: float, repeat: int, ratio: float) -> dict:
     x0, sep = problem(name)
     best, p = float("inf"), None
     for _ in range(repeat):
         t = time.perf_counter()
-        p = pave(x0, sep, eps)
+        p = pave(x0, sep, eps, ratio=ratio)
         best = min(best, time.perf_counter() - t)
     assert p is not None
     return {"seconds": best, "boundary_boxes": len(p.boundary[0]), "undetermined_area": p.boundary_area,
@@ -42,13 +42,14 @@ def main() -> None:
     ap.add_argument("--eps", type=float, nargs="+", default=[0.1, 0.01, 0.001])
     ap.add_argument("--problems", nargs="+", default=["ring", "ex26"])
     ap.add_argument("--repeat", type=int, default=3, help="best of N for ours")
+    ap.add_argument("--ratio", type=float, default=0.5, help="bisection ratio (codac cuts at 0.49)")
     args = ap.parse_args()
     worst = 0.0
     print(f"{'problem':8} {'eps':>6} | {'ours s':>8} {'boxes':>7} {'undet.':>9} | "
           f"{'codac s':>8} {'boxes':>7} {'undet.':>9} | ratio")  # fmt: skip
     for name in args.problems:
         for eps in args.eps:
-            a, c = ours(name, eps, args.repeat), codac("pave", name, eps)
+            a, c = ours(name, eps, args.repeat, args.ratio), codac("pave", name, eps)
             ratio = a["seconds"] / c["seconds"]
             worst = max(worst, ratio)
             print(f"{name:8} {eps:6g} | {a['seconds']:8.4f} {a['boundary_boxes']:7d} {a['undetermined_area']:9.5f} | "

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from . import arith, trig
+from . import interval as _interval
 from .boxes import chunked, validate_batch
 from .interval import IntervalArray
 
@@ -88,6 +89,9 @@ class Expr:
         if not isinstance(n, (int, np.integer)):
             raise ValueError(f"Expr ** n: n must be an integer, got {n!r} (use exp(n * log(x)))")
         return Expr("sqr", (self,)) if n == 2 else Expr("pown", (self,), int(n))
+
+
+_interval.DEFER_TO = (Expr,)
 
 
 def lift(v: Any) -> Expr:

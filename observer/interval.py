@@ -27,6 +27,10 @@ from . import arith
 
 Pair = tuple[np.ndarray, np.ndarray]
 
+#: types an interval operator hands over to (their reflected operator builds the result);
+#: :mod:`.expr` registers its ``Expr`` here
+DEFER_TO: tuple[type, ...] = ()
+
 
 def _check_bounds(lo: np.ndarray, hi: np.ndarray, name: str) -> None:
     if np.isnan(lo).any() or np.isnan(hi).any():
@@ -178,13 +182,13 @@ class IntervalArray:
         raise TypeError("IntervalArray: truth value is ambiguous; use is_empty(), contains() or issubset()")
 
     # ---- set operations ----------------------------------------------------------------------------
-    def __and__(self, other: Any) -> IntervalArray:
-        return IntervalArray._raw(*arith.intersect(self.pair, as_pair(other)))
+    def __and__(self, other: Any) -> Any:
+        return self._binary(other, arith.intersect, False)
 
     __rand__ = __and__
 
-    def __or__(self, other: Any) -> IntervalArray:
-        return IntervalArray._raw(*arith.hull(self.pair, as_pair(other)))
+    def __or__(self, other: Any) -> Any:
+        return self._binary(other, arith.hull, False)
 
     __ror__ = __or__
 
@@ -198,29 +202,35 @@ class IntervalArray:
     def __abs__(self) -> IntervalArray:
         return IntervalArray._raw(*arith.abs_(self.pair))
 
-    def __add__(self, o: Any) -> IntervalArray:
-        return IntervalArray._raw(*arith.add(self.pair, as_pair(o)))
+    def _binary(self, o: Any, kernel: Any, reflected: bool) -> Any:
+        if isinstance(o, DEFER_TO):
+            return NotImplemented  # e.g. an expression: let it build the node
+        a, b = (as_pair(o), self.pair) if reflected else (self.pair, as_pair(o))
+        return IntervalArray._raw(*kernel(a, b))
 
-    def __radd__(self, o: Any) -> IntervalArray:
-        return IntervalArray._raw(*arith.add(as_pair(o), self.pair))
+    def __add__(self, o: Any) -> Any:
+        return self._binary(o, arith.add, False)
 
-    def __sub__(self, o: Any) -> IntervalArray:
-        return IntervalArray._raw(*arith.sub(self.pair, as_pair(o)))
+    def __radd__(self, o: Any) -> Any:
+        return self._binary(o, arith.add, True)
 
-    def __rsub__(self, o: Any) -> IntervalArray:
-        return IntervalArray._raw(*arith.sub(as_pair(o), self.pair))
+    def __sub__(self, o: Any) -> Any:
+        return self._binary(o, arith.sub, False)
 
-    def __mul__(self, o: Any) -> IntervalArray:
-        return IntervalArray._raw(*arith.mul(self.pair, as_pair(o)))
+    def __rsub__(self, o: Any) -> Any:
+        return self._binary(o, arith.sub, True)
 
-    def __rmul__(self, o: Any) -> IntervalArray:
-        return IntervalArray._raw(*arith.mul(as_pair(o), self.pair))
+    def __mul__(self, o: Any) -> Any:
+        return self._binary(o, arith.mul, False)
 
-    def __truediv__(self, o: Any) -> IntervalArray:
-        return IntervalArray._raw(*arith.div(self.pair, as_pair(o)))
+    def __rmul__(self, o: Any) -> Any:
+        return self._binary(o, arith.mul, True)
 
-    def __rtruediv__(self, o: Any) -> IntervalArray:
-        return IntervalArray._raw(*arith.div(as_pair(o), self.pair))
+    def __truediv__(self, o: Any) -> Any:
+        return self._binary(o, arith.div, False)
+
+    def __rtruediv__(self, o: Any) -> Any:
+        return self._binary(o, arith.div, True)
 
     def __pow__(self, n: int) -> IntervalArray:
         if not isinstance(n, (int, np.integer)):

@@ -86,13 +86,16 @@ class Paving:
         )
 
 
-def pave(x0: IntervalArray | Any, sep: Sep, eps: float, max_boxes: int = 50_000_000) -> Paving:
+def pave(
+    x0: IntervalArray | Any, sep: Sep, eps: float, ratio: float = 0.5, max_boxes: int = 50_000_000
+) -> Paving:
     """Pave ``x0`` with the separator ``sep`` down to boxes of width ``eps`` (Algorithm 2.1).
 
     Args:
         x0: the initial box, an :class:`IntervalArray` of shape ``(n,)`` or ``(lo, hi)``.
         sep: the separator of the set to characterise.
         eps: the width ``w∞`` under which an undetermined box is no longer bisected (``> 0``).
+        ratio: where the widest side is cut, in ``(0, 1)`` (codac cuts at 0.49).
         max_boxes: guard on the number of boxes held in one generation.
 
     Raises:
@@ -101,6 +104,8 @@ def pave(x0: IntervalArray | Any, sep: Sep, eps: float, max_boxes: int = 50_000_
     lo0, hi0 = x0.pair if isinstance(x0, IntervalArray) else x0
     if not (isinstance(eps, (int, float, np.floating)) and eps > 0 and np.isfinite(eps)):
         raise ValueError(f"eps: must be a positive finite number, got {eps!r}")
+    if not 0.0 < ratio < 1.0:
+        raise ValueError(f"ratio: must lie in (0, 1), got {ratio!r}")
     lo, hi = validate_batch(lo0, hi0, "x0", sep.n)
     if lo.shape[0] != 1:
         raise ValueError(f"x0: expected one initial box, got {lo.shape[0]}")
@@ -131,7 +136,7 @@ def pave(x0: IntervalArray | Any, sep: Sep, eps: float, max_boxes: int = 50_000_
         left = np.full(lo.shape[0], -1, dtype=np.int64)
         left[split] = n_nodes + 2 * np.arange(split.size)
         t_left.append(left)
-        (l_lo, l_hi), (r_lo, r_hi) = bisect(b_lo[split], b_hi[split])
+        (l_lo, l_hi), (r_lo, r_hi) = bisect(b_lo[split], b_hi[split], ratio)
         k = split.size
         lo = np.empty((2 * k, lo.shape[1]))
         hi = np.empty_like(lo)

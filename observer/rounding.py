@@ -111,15 +111,22 @@ def _sum_error(a: np.ndarray, b: np.ndarray, s: np.ndarray) -> np.ndarray:
 
 #: Rump, Zimmermann, Boldo & Melquiond (2009): for finite c, fl(c ± fl(φ|c| + η)) is the successor
 #: (predecessor) of c, or the one after it for |c| near the smallest normal; always strictly beyond c.
+#: There the exact integer step is used instead.
 _PHI = 2.0**-53 * (1.0 + 2.0**-52)
 _ETA = 2.0**-1074
+_NEAR_SUBNORMAL = 2.0**-1019  # where fl(c ± (φ|c| + η)) can skip a float
 
 
 def _step(r: np.ndarray, mask: np.ndarray, up: bool) -> np.ndarray:
-    """One ulp (at most two near the subnormals) outward where ``mask``: 4 array passes."""
+    """Exactly one ulp outward where ``mask``: 4 array passes, plus the exact integer step for the rare
+    values near the smallest normal where the formula may go two ulps."""
     with np.errstate(over="ignore", invalid="ignore"):
-        e = np.abs(r) * _PHI + _ETA
-        return np.where(mask, r + e if up else r - e, r)
+        a = np.abs(r)
+        out = np.where(mask, r + (a * _PHI + _ETA) if up else r - (a * _PHI + _ETA), r)
+        near = mask & (a < _NEAR_SUBNORMAL)
+        if near.any():
+            out = np.where(near, next_up(r) if up else next_down(r), out)
+        return out
 
 
 def _direct(r: np.ndarray, err: np.ndarray, up: bool) -> np.ndarray:

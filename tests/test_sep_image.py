@@ -8,6 +8,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
+
 from digslam.observer.boxes import empty_rows
 from digslam.observer.sep_image import CtcImage, SepImage
 from digslam.observer.sep_polygon import SepPolygon

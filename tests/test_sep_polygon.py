@@ -6,6 +6,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
+
 from digslam.observer.boxes import empty_rows
 from digslam.observer.sep_polygon import CtcPolygonBoundary, CtcSegments, SepPolygon, orient
 from digslam.observer.separators import check_separation

@@ -1,0 +1,140 @@
+"""Steps per second of ``digslam/Explore-v0`` (exact cones) against a pymunk ray-casting reference loop.
+
+Both run the same 30-rock world, 8 sonar cones plus the omnidirectional sensor, dt = 0.1 s with 4 substeps
+and the same random actions. The reference casts 5 rays per cone with ``Space.segment_query_first`` and gets
+the omni range from ``Space.point_query_nearest``; it has no noise, no record, no reward. Ours computes the
+exact cone distances, the noisy intervals, the mission record, the ground truth and the coverage reward.
+
+Usage: ``python benchmarks/bench_env.py [--steps N] [--repeats R]``. The last line is
+``ratio_vs_raycast=<ours / reference>`` (median of the repeats, wall-clock time).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+
+import gymnasium as gym
+import numpy as np
+import pymunk
+
+import digslam.envs  # noqa: F401  (registers the environments)
+from digslam.envs.robot import RobotSim
+
+RAYS_PER_CONE = 5
+
+
+def make_ours() -> gym.Env:
+    """The benchmarked environment: the rock field of 30 obstacles, 8 cones + omni."""
+    return gym.make(
+        "digslam/Explore-v0", world="rocks", n_obstacles=30, n_sonars=8, omni=True, dt=0.1, substeps=4
+    )
+
+
+def run_ours(env: gym.Env, actions: np.ndarray) -> float:
+    """Wall time of ``len(actions)`` env steps."""
+    env.reset(seed=0)
+    t0 = time.perf_counter()
+    for a in actions:
+        env.step(a)
+    return time.perf_counter() - t0
+
+
+def run_reference(env: gym.Env, actions: np.ndarray) -> float:
+    """Wall time of the pymunk ray-casting loop on the same world and actions."""
+    u = env.unwrapped
+    env.reset(seed=0)
+    cfg, suite = u.config, u.suite
+    sim = RobotSim(u.world, cfg.robot_radius, u.sim.pose, cfg.max_force, cfg.max_torque)
+    space, body = sim.space, sim.body
+    filt = pymunk.ShapeFilter(group=1)
+    sim.shape.filter = filt
+    cones = [(a, g, r) for a, g, r in zip(suite.alpha, suite.gamma, suite.r_max, strict=True) if g < math.pi]
+    offsets = [
+        (a + g * (2 * k / (RAYS_PER_CONE - 1) - 1), r) for a, g, r in cones for k in range(RAYS_PER_CONE)
+    ]
+    omni_range = float(suite.r_max[suite.gamma >= math.pi][0])
+    h = cfg.dt / cfg.substeps
+    t0 = time.perf_counter()
+    for a in actions:
+        v, w = float(a[0]) * cfg.max_speed, float(a[1]) * cfg.max_yaw_rate
+        for _ in range(cfg.substeps):
+            th = body.angle
+            sim.control.velocity = (v * math.cos(th), v * math.sin(th))
+            sim.control.angular_velocity = w
+            space.step(h)
+        p, th = body.position, body.angle
+        ranges = []
+        for off, r in offsets:
+            end = (p.x + r * math.cos(th + off), p.y + r * math.sin(th + off))
+            hit = space.segment_query_first(p, end, 0.0, filt)
+            ranges.append(hit.alpha * r if hit is not None else math.inf)
+        nearest = space.point_query_nearest(p, omni_range, filt)
+        ranges.append(nearest.distance if nearest is not None else math.inf)
+    return time.perf_counter() - t0
+
+
+def sensing_only(env: gym.Env, n: int) -> tuple[float, float]:
+    """Sensor calls per second at ``n`` free poses: exact cones vs the reference ray fan (no physics)."""
+    u = env.unwrapped
+    env.reset(seed=0)
+    world, suite, space = u.world, u.suite, u.sim.space
+    filt = pymunk.ShapeFilter(group=1)
+    u.sim.shape.filter = filt
+    rng = np.random.default_rng(1)
+    poses = [world.sample_free_pose(rng, 0.3) for _ in range(n)]
+    cones = [(a, g, r) for a, g, r in zip(suite.alpha, suite.gamma, suite.r_max, strict=True) if g < math.pi]
+    offsets = [
+        (a + g * (2 * k / (RAYS_PER_CONE - 1) - 1), r) for a, g, r in cones for k in range(RAYS_PER_CONE)
+    ]
+    t0 = time.perf_counter()
+    for p in poses:
+        suite.true_ranges(world, p)
+    t1 = time.perf_counter()
+    for x, y, th in poses:
+        for off, r in offsets:
+            space.segment_query_first(
+                (x, y), (x + r * math.cos(th + off), y + r * math.sin(th + off)), 0.0, filt
+            )
+        space.point_query_nearest((x, y), 5.0, filt)
+    t2 = time.perf_counter()
+    return n / (t1 - t0), n / (t2 - t1)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--steps", type=int, default=2000)
+    parser.add_argument("--repeats", type=int, default=5)
+    args = parser.parse_args()
+    env = make_ours()
+    rng = np.random.default_rng(0)
+    actions = np.column_stack([rng.uniform(0.3, 1.0, args.steps), rng.uniform(-1, 1, args.steps)])
+    actions = actions.astype(np.float32)
+    env.reset(seed=0)
+    n_edges = len(env.unwrapped.world.edges)
+    ours, ref = [], []
+    for _ in range(args.repeats):
+        ours.append(args.steps / run_ours(env, actions))
+        ref.append(args.steps / run_reference(env, actions))
+    o, r = float(np.median(ours)), float(np.median(ref))
+    s_ours, s_ref = sensing_only(env, args.steps)
+    print(
+        f"world: rocks, 30 obstacles, {n_edges} edges; 8 cones + omni; dt=0.1 s, 4 substeps; "
+        f"{args.steps} steps"
+    )
+    print(
+        f"ours_steps_per_s={o:.0f}  (exact cones, noise, record, truth, coverage reward; gym.make wrappers)"
+    )
+    print(
+        f"reference_steps_per_s={r:.0f}  "
+        f"(pymunk, {RAYS_PER_CONE} rays/cone segment_query_first + omni nearest)"
+    )
+    print(
+        f"sensing_only: exact_cones_per_s={s_ours:.0f} ray_fan_per_s={s_ref:.0f} ratio={s_ours / s_ref:.3f}"
+    )
+    print(f"ratio_vs_raycast={o / r:.3f}")
+
+
+if __name__ == "__main__":
+    main()

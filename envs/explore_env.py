@@ -1,0 +1,209 @@
+"""``digslam/Explore-v0``: a disc robot with exact sonar cones exploring an unknown world.
+
+Action: normalised ``(v, omega)`` in ``[-1, 1]^2``. Observation (dict): range intervals ``ranges (n, 2)``
+(``[r_max, top]`` where no echo), ``no_echo (n,)``, ``odometry (2, 2)`` (speed and yaw-rate intervals) and
+``heading (2,)`` (compass interval, shifted by a multiple of 2 pi into about ``[-pi, pi]``). Reward: the newly
+and truly sensed free area (m^2). ``info`` holds the :class:`~digslam.observer.record.MissionRecord` under
+``"record"`` and the :class:`~digslam.envs.episode.GroundTruth` under ``"truth"``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from digslam.observer.record import MissionRecord
+
+from .config import ExploreConfig
+from .coverage import Coverage
+from .episode import GroundTruth
+from .generators import GENERATORS, WorldGenerator
+from .robot import RobotSim
+from .sensors import SensorSuite, measure_step
+from .world import World
+
+
+def _generator(cfg: ExploreConfig) -> WorldGenerator:
+    if cfg.world == "file":
+        return GENERATORS["file"](cfg.map_path, size=cfg.world_size)  # type: ignore[call-arg]
+    if cfg.world == "rocks":
+        return GENERATORS["rocks"](size=cfg.world_size, n=cfg.n_obstacles)  # type: ignore[call-arg]
+    return GENERATORS[cfg.world](size=cfg.world_size)
+
+
+class ExploreEnv(gym.Env):
+    """Exploration environment; see the module docstring.
+
+    Args:
+        config: An :class:`ExploreConfig`, a mapping, or None for the defaults.
+        render_mode: ``"rgb_array"``, ``"human"`` or None.
+        **overrides: Config fields overriding ``config`` (unknown keys raise ``ValueError``).
+    """
+
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
+
+    def __init__(
+        self,
+        config: ExploreConfig | Mapping[str, Any] | None = None,
+        render_mode: str | None = None,
+        **overrides: Any,
+    ) -> None:
+        if isinstance(config, ExploreConfig):
+            cfg = config.replace(**overrides) if overrides else config
+        else:
+            cfg = ExploreConfig.from_dict(config or {}, **overrides)
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode: must be one of {self.metadata['render_modes']}, got {render_mode!r}"
+            )
+        self.config, self.render_mode = cfg, render_mode
+        self.suite = SensorSuite.from_config(cfg)
+        self.generator = _generator(cfg)
+        n, nz = self.suite.n, cfg.noise
+        self._top = float(self.suite.r_max.max() + 2 * nz.range + 1.0)
+        self._odo_top = np.array(
+            [[10 * cfg.max_speed + 2 * nz.speed + 1.0], [10 * cfg.max_yaw_rate + 2 * nz.yaw_rate + 1.0]]
+        )
+        self.action_space = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
+        self.observation_space = spaces.Dict(
+            {
+                "ranges": spaces.Box(0.0, self._top, shape=(n, 2), dtype=np.float64),
+                "no_echo": spaces.MultiBinary(n),
+                "odometry": spaces.Box(
+                    -np.repeat(self._odo_top, 2, 1), np.repeat(self._odo_top, 2, 1), dtype=np.float64
+                ),
+                "heading": spaces.Box(
+                    -math.pi - 1.0 - 2 * nz.heading,
+                    math.pi + 1.0 + 2 * nz.heading,
+                    shape=(2,),
+                    dtype=np.float64,
+                ),
+            }
+        )
+        self.world: World | None = None
+        self.sim: RobotSim | None = None
+        self.coverage: Coverage | None = None
+        self._renderer: Any = None
+
+    # --- gymnasium API -------------------------------------------------------------------------------------
+    def reset(
+        self,
+        *,
+        seed: int | None = None,
+        options: dict[str, Any] | None = None,
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        super().reset(seed=seed)
+        cfg = self.config
+        if seed is not None or self.world is None or not cfg.fixed_world:
+            self.world = self.generator.generate(int(self.np_random.integers(2**31 - 1)))
+        heading = float(self.np_random.uniform(-math.pi, math.pi))
+        skin = 1.5 * cfg.max_speed * cfg.dt / cfg.substeps
+        if cfg.start is not None:
+            pose = np.asarray(cfg.start, dtype=np.float64)
+            self.world.check_start(pose, cfg.robot_radius + skin)
+        elif self.world.clearance(np.zeros((1, 2)))[0] >= 1.5 * cfg.robot_radius + skin:
+            pose = np.array([0.0, 0.0, heading])
+        else:
+            pose = self.world.sample_free_pose(self.np_random, 1.5 * cfg.robot_radius + skin)
+        self.sim = RobotSim(self.world, cfg.robot_radius, pose, cfg.max_force, cfg.max_torque, skin)
+        self.coverage = Coverage(self.world, cfg.coverage_resolution, float(self.suite.r_max.max()))
+        self.t, self.path = 0.0, [pose[:2].copy()]
+        record, truth = self._sense(0)
+        self.coverage.update(truth.pose, self.suite, truth.ranges)
+        self._last = record
+        return self._obs(record), self._info(record, truth)
+
+    def step(self, action: np.ndarray) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        if self.sim is None:
+            raise RuntimeError("step: call reset() before step()")
+        a = self._check_action(action)
+        cfg = self.config
+        bumps = self.sim.step(a[0] * cfg.max_speed, a[1] * cfg.max_yaw_rate, cfg.dt, cfg.substeps)
+        self.t += cfg.dt
+        record, truth = self._sense(bumps)
+        self.path.append(truth.pose[:2].copy())
+        self._last = record
+        reward = self._reward(truth)
+        if self.render_mode == "human":
+            self.render()
+        return self._obs(record), reward, self._terminated(), False, self._info(record, truth)
+
+    def render(self) -> np.ndarray | None:
+        if self.render_mode is None:
+            gym.logger.warn("render: no render_mode was given at construction")
+            return None
+        if self._renderer is None:
+            from .render import Renderer
+
+            self._renderer = Renderer(self.render_mode, self.metadata["render_fps"])
+        return self._renderer.draw(self)
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    # --- pieces of step ------------------------------------------------------------------------------------
+    def _check_action(self, action: np.ndarray) -> tuple[float, float]:
+        a = np.asarray(action)
+        if a.shape != (2,):
+            raise ValueError(f"action: expected shape (2,), got {a.shape}")
+        v, w = float(a[0]), float(a[1])
+        if not (math.isfinite(v) and math.isfinite(w)):
+            raise ValueError(f"action: must be finite, got {[v, w]}")
+        if abs(v) > 1.0 + 1e-6 or abs(w) > 1.0 + 1e-6:
+            raise ValueError(f"action: must lie in [-1, 1]^2 (normalised v, omega), got {[v, w]}")
+        return min(max(v, -1.0), 1.0), min(max(w, -1.0), 1.0)
+
+    def _sense(self, bumps: int) -> tuple[MissionRecord, GroundTruth]:
+        assert self.sim is not None and self.world is not None
+        pose = self.sim.pose
+        ranges = self.suite.true_ranges(self.world, pose)
+        speed, yaw = self.sim.speed, self.sim.yaw_rate
+        record = measure_step(
+            self.t, self.suite, ranges, speed, yaw, pose[2], self.config.noise, self.np_random
+        )
+        truth = GroundTruth(
+            t=self.t,
+            pose=pose,
+            speed=speed,
+            yaw_rate=yaw,
+            ranges=ranges,
+            bumps=bumps,
+            bumps_total=self.sim.bumps,
+        )
+        return record, truth
+
+    def _reward(self, truth: GroundTruth) -> float:
+        assert self.coverage is not None
+        return self.coverage.update(truth.pose, self.suite, truth.ranges)
+
+    def _terminated(self) -> bool:
+        assert self.coverage is not None
+        return self.coverage.fraction >= 1.0
+
+    def _info(self, record: MissionRecord, truth: GroundTruth) -> dict[str, Any]:
+        assert self.coverage is not None
+        return {
+            "record": record,
+            "truth": truth,
+            "coverage": self.coverage.fraction,
+            "bumps": int(truth.bumps_total),
+        }
+
+    def _obs(self, record: MissionRecord) -> dict[str, np.ndarray]:
+        h = record.heading
+        k = np.round(0.5 * (h[0] + h[1]) / (2 * math.pi)) * 2 * math.pi
+        hb = self.observation_space["heading"]
+        odo = np.array([record.speed, record.yaw_rate])
+        return {
+            "ranges": np.minimum(record.range, self._top),  # lower bounds are >= 0 by construction
+            "no_echo": record.no_echo.astype(np.int8),
+            "odometry": np.minimum(np.maximum(odo, -self._odo_top), self._odo_top),
+            "heading": np.minimum(np.maximum(h - k, hb.low), hb.high),
+        }
