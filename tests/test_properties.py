@@ -242,8 +242,9 @@ seed_st = st.integers(0, 2**32 - 1)
 # ---- inclusion -------------------------------------------------------------------------------------
 
 
-def check_inclusion(f: Function, exact: Callable[..., Exact], seed: int, specials: list[float],
-                    prefilter: bool = True) -> None:
+def check_inclusion(
+    f: Function, exact: Callable[..., Exact], seed: int, specials: list[float], prefilter: bool = True
+) -> None:
     """Exact ``f(pt)`` in ``[f](box)``. With ``prefilter`` (single primitives only, whose numpy value is
     within 4 ulps: see test_rounding.py) points whose numpy value is 16 ulps inside the enclosure are
     accepted without the exact evaluation; the others (near a bound, non-finite) are checked exactly."""
@@ -263,7 +264,9 @@ def check_inclusion(f: Function, exact: Callable[..., Exact], seed: int, special
             continue
         if not inside(float(rlo[i]), float(rhi[i]), v):
             bad.append((lo[i].tolist(), hi[i].tolist(), pt[i].tolist(), float(rlo[i]), float(rhi[i]), str(v)))
-    assert not bad, f"{len(bad)} points outside [f](box): (box lo, box hi, point, [f] lo, [f] hi, f(point)) {bad[:3]}"
+    assert not bad, (
+        f"{len(bad)} points outside [f](box): (box lo, box hi, point, [f] lo, [f] hi, f(point)) {bad[:3]}"
+    )
 
 
 @pytest.mark.parametrize("name", list(PRIMITIVES) + list(COMPOSITES))
@@ -366,11 +369,13 @@ def test_contractor_sound_pown(n, seed, specials, widen):
 
 
 VEC = Function(lambda x: ((x[0] - 2) ** 2 + (x[1] - 2.5) ** 2, x[0] * cos(x[1])))
-G4 = Function(lambda x: exp(-x[0] ** 2) * sin(3 * x[0]), n=2)
+G4 = Function(lambda x: exp(-(x[0] ** 2)) * sin(3 * x[0]), n=2)
 
 
 def _algebra_cases(seed: int, specials: list[float], widen: bool, fixpoints: bool):
-    fns = [COMPOSITES[k] for k in ("ring", "x1cosx2", "atan2_minus_prod")] + [(G4, COMPOSITES["gauss_sin"][1])]
+    fns = [COMPOSITES[k] for k in ("ring", "x1cosx2", "atan2_minus_prod")] + [
+        (G4, COMPOSITES["gauss_sin"][1])
+    ]
     exacts = [fns[0][1], fns[1][1], fns[2][1], lambda a, b: fns[3][1](a)]
     for x0, lo, hi, ys in anchored(seed, specials, exacts, 2):
         c1, c2, c3, c4 = (CtcFwdBwd(f, y_interval(v, widen)) for (f, _), v in zip(fns, ys))

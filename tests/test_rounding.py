@@ -117,8 +117,10 @@ def check_binary(op: str, a: np.ndarray, b: np.ndarray) -> None:
             if not (d == ex == u):
                 failures.append((x, y, d, u, ex))
             continue
-        if math.isnan(d) or math.isnan(u) or not (
-            (d == -math.inf or Fraction(d) <= ex) and (u == math.inf or ex <= Fraction(u))
+        if (
+            math.isnan(d)
+            or math.isnan(u)
+            or not ((d == -math.inf or Fraction(d) <= ex) and (u == math.inf or ex <= Fraction(u)))
         ):
             failures.append((x, y, d, u, "unsound"))
             continue
@@ -198,7 +200,9 @@ def check_sqrt(a: np.ndarray) -> None:
 def test_sqrt_random_all_binades():
     rng = np.random.default_rng(42)
     a = np.abs(random_floats(rng, 8000))
-    squares = np.ldexp(rng.integers(1, 2**26, 2000).astype(np.float64) ** 2, 2 * rng.integers(-520, 485, 2000))
+    squares = np.ldexp(
+        rng.integers(1, 2**26, 2000).astype(np.float64) ** 2, 2 * rng.integers(-520, 485, 2000)
+    )
     check_sqrt(np.concatenate([a, squares, np.abs(np.array(SPECIALS))]))
 
 
@@ -219,8 +223,11 @@ def test_next_and_widen():
     assert rnd.PI_UP == math.nextafter(rnd.PI_DOWN, math.inf)
     with mpmath.workdps(50):
         pi = +mpmath.pi
-        for lo, hi, k in ((rnd.PI_DOWN, rnd.PI_UP, 1), (rnd.HALF_PI_DOWN, rnd.HALF_PI_UP, 0.5),
-                          (rnd.TWO_PI_DOWN, rnd.TWO_PI_UP, 2)):
+        for lo, hi, k in (
+            (rnd.PI_DOWN, rnd.PI_UP, 1),
+            (rnd.HALF_PI_DOWN, rnd.HALF_PI_UP, 0.5),
+            (rnd.TWO_PI_DOWN, rnd.TWO_PI_UP, 2),
+        ):
             assert mpmath.mpf(lo) < k * pi < mpmath.mpf(hi)
 
 
@@ -238,7 +245,11 @@ def _args(name: str, rng: np.random.Generator) -> tuple[np.ndarray, ...]:
     n = N_LIBM
     q = n // 4
     if name == "exp":
-        return (np.concatenate([rng.uniform(-745, 709.7, q), rng.uniform(-5, 5, q), _log_uniform(rng, -60, 3, 2 * q)]),)
+        return (
+            np.concatenate(
+                [rng.uniform(-745, 709.7, q), rng.uniform(-5, 5, q), _log_uniform(rng, -60, 3, 2 * q)]
+            ),
+        )
     if name == "log":
         return (np.concatenate([
             _log_uniform(rng, -1074, 1024, q, signed=False), rng.uniform(0.5, 2, q),
