@@ -127,7 +127,7 @@ class CtcFixPoint(Ctc):
             alo, ahi = lo[active], hi[active]
             clo, chi = normalize_empty(*self.ctc.contract(alo, ahi))
             lo[active], hi[active] = clo, chi
-            with np.errstate(invalid="ignore"):
+            with np.errstate(invalid="ignore", over="ignore"):
                 before = (ahi - alo).sum(axis=1)
                 after = (chi - clo).sum(axis=1)
                 changed = (clo != alo).any(axis=1) | (chi != ahi).any(axis=1)
@@ -153,9 +153,10 @@ class CtcFwdBwd(Ctc):
         if isinstance(y, tuple) and len(y) == 2 and not isinstance(y, IntervalArray):
             y = IntervalArray(*y)
         ylo, yhi = as_pair(y, "y")
+        if np.shape(ylo) not in ((), (self.f.m,)):
+            shape = np.shape(ylo)
+            raise ValueError(f"y: expected an interval or a box of dimension {self.f.m}, got shape {shape}")
         ylo, yhi = np.broadcast_to(ylo, (self.f.m,)), np.broadcast_to(yhi, (self.f.m,))
-        if np.shape(as_pair(y)[0]) not in ((), (self.f.m,)):
-            raise ValueError(f"y: expected an interval or a box of dimension {self.f.m}, got {np.shape(ylo)}")
         self.y = (ylo.astype(np.float64), yhi.astype(np.float64))
 
     def contract(self, lo: np.ndarray, hi: np.ndarray) -> Batch:

@@ -382,11 +382,6 @@ def test_ctc_fwdbwd_y_of_wrong_dimension():
         CtcFwdBwd(f, IntervalArray([0.0], [1.0]))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="contractors.py CtcFwdBwd.__init__ broadcasts y to (m,) before checking its shape: a y longer "
-    "than m raises numpy's broadcast error, which does not name the argument y",
-)
 @pytest.mark.parametrize("m, ydim", [(2, 3), (1, 2)])
 def test_ctc_fwdbwd_y_longer_than_output(m, ydim):
     f = Function(lambda x: (x[0] + x[1], x[0] - x[1])) if m == 2 else FUNCTIONS["ring"]
