@@ -65,12 +65,51 @@ def eval_task(n_boxes: int, seed: int) -> dict:
     return {"eval_seconds": t_eval, "ctc_seconds": t_ctc}
 
 
+def polar_task(kind: str, eps: float) -> dict:
+    """One-landmark localization (§3.4.1.1): landmark at the origin, range [4, 6], bearing [-π/12, π/4],
+    frame [-6, 4]², paved with ``SepInverse`` of (range, atan2) (``inverse``) or ``SepPolarCart`` (``polar``)."""
+    import math
+
+    import codac
+
+    x0 = codac.IntervalVector([[-6, 4], [-6, 4]])
+    if kind == "inverse":
+        x = codac.VectorVar(2)  # m - x = -x = π(ρ, θ)
+        f = codac.AnalyticFunction([x], codac.vec(codac.sqrt(codac.sqr(x[0]) + codac.sqr(x[1])),
+                                                  codac.atan2(-x[1], -x[0])))  # fmt: skip
+        sep = codac.SepInverse(f, codac.IntervalVector([[4, 6], [-math.pi / 12, math.pi / 4]]))
+    else:  # the pie of x = -π(ρ, θ): bearings shifted by π
+        pie = codac.IntervalVector([[4, 6], [-math.pi / 12 + math.pi, math.pi / 4 + math.pi]])
+        sep = codac.SepPolarCart(codac.SepWrapper_IntervalVector(pie))
+    t = time.perf_counter()
+    p = codac.pave(x0, sep, eps)
+    dt = time.perf_counter() - t
+    count = [0]
+
+    def visit(node) -> bool:  # noqa: ANN001
+        count[0] += 0 if node.is_leaf() else 1
+        return True
+
+    p.tree().visit(visit)
+    bound = p.boxes(codac.PavingInOut.bound)
+    inner = p.boxes(codac.PavingInOut.inner)
+    return {
+        "seconds": dt,
+        "bisections": count[0],
+        "boundary_boxes": len(bound),
+        "undetermined_area": sum(b.volume() for b in bound),
+        "inner_area": sum(b.volume() for b in inner),
+    }
+
+
 if __name__ == "__main__":
     task = sys.argv[1]
     if task == "pave":
         out = pave_task(sys.argv[2], float(sys.argv[3]))
     elif task == "eval":
         out = eval_task(int(sys.argv[2]), int(sys.argv[3]))
+    elif task == "polar":
+        out = polar_task(sys.argv[2], float(sys.argv[3]))
     else:
         raise SystemExit(f"codac_peer: unknown task {task!r} (pave or eval)")
     print(json.dumps(out))

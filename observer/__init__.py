@@ -9,8 +9,30 @@ from . import arith, boxes, rounding, trig
 from .contractors import Ctc, CtcCompose, CtcFixPoint, CtcFwdBwd, CtcInter, CtcUnion
 from .expr import Expr, Function
 from .interval import Box, Interval, IntervalArray, dot
+from .minkowski import SepMinkowskiDiff, SepMinkowskiSum, sep_negate
 from .ops import abs_, acos, asin, atan, atan2, cos, exp, log, maximum, minimum, pown, sin, sqr, sqrt, tan
 from .paver import Paving, PavingTree, classify_grid, pave
+from .polar_ctc import CtcPolar
+from .polar_sep import (
+    SepCtcPreimage,
+    SepLandmark,
+    SepPi,
+    SepPiInv,
+    SepPolarXY,
+    complement_boxes,
+    sep_landmark_fwdbwd,
+)
+from .projection import SepOnDims, SepProj
+from .registration import (
+    SepRegistration,
+    rigid2d,
+    scaling,
+    sep_cone,
+    sep_inclusion,
+    sep_intersection,
+    transform_function,
+    translation,
+)
 from .sep_image import CtcImage, SepImage
 from .sep_inverse import SepInverse
 from .sep_polygon import CtcPolygonBoundary, CtcSegments, SepPolygon
@@ -24,6 +46,11 @@ __all__ = [
     "Paving", "PavingTree", "classify_grid", "pave", "SepInverse",
     "CtcImage", "SepImage", "CtcPolygonBoundary", "CtcSegments", "SepPolygon",
     "CtcTransform", "SepTransform", "Transform", "symmetric_union",
+    "SepMinkowskiDiff", "SepMinkowskiSum", "sep_negate", "SepOnDims", "SepProj", "SepRegistration",
+    "rigid2d", "scaling", "sep_cone", "sep_inclusion", "sep_intersection", "transform_function",
+    "translation",
+    "CtcPolar", "SepCtcPreimage", "SepLandmark", "SepPi", "SepPiInv", "SepPolarXY", "complement_boxes",
+    "sep_landmark_fwdbwd",
     "SepSubpaving", "load", "save", "simplify",
     "Sep", "SepBox", "SepInter", "SepNot", "SepQInter", "SepUnion",
     "Expr", "Function", "Box", "Interval", "IntervalArray", "dot",

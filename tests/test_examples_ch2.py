@@ -8,29 +8,18 @@ script must write a non-empty PNG.
 
 from __future__ import annotations
 
-import importlib.util
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from example_loader import load, run_cache
 
 from digslam.observer import Box, pave
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 pytest.importorskip("matplotlib")
 
 
-def load(name: str):
-    """Import ``examples/<name>.py`` by path (cached in sys.modules under a private name)."""
-    key = f"_digslam_example_{name}"
-    if key in sys.modules:
-        return sys.modules[key]
-    spec = importlib.util.spec_from_file_location(key, EXAMPLES / f"{name}.py")
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[key] = mod
-    spec.loader.exec_module(mod)
-    return mod
 
 
 #: coarse precisions: the whole file stays well under the 40 s budget
@@ -44,15 +33,7 @@ PNG = {"ex2_6_three_rings": ["ex2_6_three_rings.png"], "ex2_7_ring": ["ex2_7_rin
 @pytest.fixture(scope="module")
 def results(tmp_path_factory) -> dict:
     """Every example run once at its coarse ε, drawing into a temporary folder."""
-    out = tmp_path_factory.mktemp("examples_ch2")
-    cache: dict = {}
-
-    def get(name: str) -> dict:
-        if name not in cache:
-            cache[name] = load(name).run(eps=EPS[name], out=out)
-        return cache[name]
-
-    return get
+    return run_cache(tmp_path_factory.mktemp("examples_ch2"), EPS)
 
 
 def sample_boxes(lo: np.ndarray, hi: np.ndarray, per_box: int, rng: np.random.Generator) -> np.ndarray:
