@@ -27,10 +27,6 @@ def set_empty(lo: np.ndarray, hi: np.ndarray, mask: np.ndarray) -> Pair:
     return np.where(mask, _INF, lo), np.where(mask, -_INF, hi)
 
 
-def _f(x: object) -> np.ndarray:
-    return np.asarray(x, dtype=np.float64)
-
-
 def neg(a: Pair) -> Pair:
     """``-[a] = [-a⁺, -a⁻]``."""
     return np.negative(a[1]) + 0.0, np.negative(a[0]) + 0.0
@@ -211,8 +207,3 @@ def hull(a: Pair, b: Pair) -> Pair:
     """``[a] ⊔ [b]``, the smallest interval containing both (Eq. 2.4); empties are neutral."""
     return np.minimum(a[0], b[0]), np.maximum(a[1], b[1])
 
-
-def const(value: object, shape: tuple[int, ...] = ()) -> Pair:
-    """Point interval ``[v, v]`` (broadcast to ``shape``); ``v`` must be an exact float."""
-    v = np.broadcast_to(_f(value), shape) if shape else _f(value)
-    return v, v

@@ -119,14 +119,6 @@ def bisect(lo: np.ndarray, hi: np.ndarray, ratio: float = 0.5) -> tuple[Batch, B
     return (lo, hi1), (lo2, hi)
 
 
-def hull_rows(lo: np.ndarray, hi: np.ndarray) -> Batch:
-    """The smallest box containing every row (empty rows ignored): ``(n,)`` arrays."""
-    return lo.min(axis=0), hi.max(axis=0)
-
-
-def contains_points(lo: np.ndarray, hi: np.ndarray, pts: np.ndarray) -> np.ndarray:
-    """``(N,)`` mask: point ``pts[i]`` lies in box ``i`` (or ``pts`` broadcasts against the rows)."""
-    return ((lo <= pts) & (pts <= hi)).all(axis=-1)
 
 
 def box_difference(
