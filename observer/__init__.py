@@ -38,6 +38,18 @@ from .sep_inverse import SepInverse
 from .sep_polygon import CtcPolygonBoundary, CtcSegments, SepPolygon
 from .separators import Sep, SepBox, SepInter, SepNot, SepQInter, SepUnion
 from .subpaving import SepSubpaving, load, save, simplify
+from .thick_inversion import SepFixedParam, thick_inverse_classical, thick_inverse_proj
+from .thick_paver import ThickPaving, thick_pave
+from .thick_sep import (
+    CLEAR,
+    DARK,
+    PENUMBRA,
+    UNKNOWN,
+    ThickSep,
+    thick_classify_grid,
+    thick_relaxed_intersection,
+)
+from .thick_set import ctc_equal, ctc_subset
 from .transforms import CtcTransform, SepTransform, Transform, symmetric_union
 
 __all__ = [
@@ -51,6 +63,9 @@ __all__ = [
     "translation",
     "CtcPolar", "SepCtcPreimage", "SepLandmark", "SepPi", "SepPiInv", "SepPolarXY", "complement_boxes",
     "sep_landmark_fwdbwd",
+    "SepFixedParam", "thick_inverse_classical", "thick_inverse_proj", "ThickPaving", "thick_pave",
+    "CLEAR", "DARK", "PENUMBRA", "UNKNOWN", "ThickSep", "thick_classify_grid", "thick_relaxed_intersection",
+    "ctc_equal", "ctc_subset",
     "SepSubpaving", "load", "save", "simplify",
     "Sep", "SepBox", "SepInter", "SepNot", "SepQInter", "SepUnion",
     "Expr", "Function", "Box", "Interval", "IntervalArray", "dot",
