@@ -38,6 +38,8 @@ from .sep_inverse import SepInverse
 from .sep_polygon import CtcPolygonBoundary, CtcSegments, SepPolygon
 from .separators import Sep, SepBox, SepInter, SepNot, SepQInter, SepUnion
 from .subpaving import SepSubpaving, load, save, simplify
+from .thick_function import ThickFunction
+from .thick_interval import ThickIntervalArray, thin
 from .thick_inversion import SepFixedParam, thick_inverse_classical, thick_inverse_proj
 from .thick_paver import ThickPaving, thick_pave
 from .thick_sep import (
@@ -65,7 +67,7 @@ __all__ = [
     "sep_landmark_fwdbwd",
     "SepFixedParam", "thick_inverse_classical", "thick_inverse_proj", "ThickPaving", "thick_pave",
     "CLEAR", "DARK", "PENUMBRA", "UNKNOWN", "ThickSep", "thick_classify_grid", "thick_relaxed_intersection",
-    "ctc_equal", "ctc_subset",
+    "ctc_equal", "ctc_subset", "ThickFunction", "ThickIntervalArray", "thin",
     "SepSubpaving", "load", "save", "simplify",
     "Sep", "SepBox", "SepInter", "SepNot", "SepQInter", "SepUnion",
     "Expr", "Function", "Box", "Interval", "IntervalArray", "dot",

@@ -50,3 +50,19 @@ def test_bad_input():
         ThickIntervalArray([5.0], [6.0], [1.0], [2.0])
     with pytest.raises(ValueError, match="shape"):
         ThickIntervalArray(np.zeros(2), np.zeros(3), np.zeros(2), np.zeros(2))
+
+
+def test_thick_function_and_parametric():
+    from digslam.observer import Function
+    from digslam.observer.thick_function import ThickFunction
+
+    tf = ThickFunction(Function(lambda x: x[0] - 1), Function(lambda x: x[0] + 1))
+    r = tf.eval(np.array([[0.0], [2.0]]), np.array([[1.0], [2.0]]))
+    assert r.lo_lo.ravel().tolist() == [-1.0, 1.0] and r.hi_hi.ravel().tolist() == [2.0, 3.0]
+    pf = ThickFunction.from_parametric(Function(lambda x, p: x * p), [1.0], [2.0])
+    rng = np.random.default_rng(0)
+    xs = rng.uniform(0, 3, 50)
+    r = pf.eval(xs[:, None], xs[:, None])
+    lo_true, hi_true = xs * 1.0, xs * 2.0  # f⁻, f⁺ for x ≥ 0
+    assert np.all(r.lo_lo.ravel() <= lo_true) and np.all(lo_true <= r.lo_hi.ravel())
+    assert np.all(r.hi_lo.ravel() <= hi_true) and np.all(hi_true <= r.hi_hi.ravel())
