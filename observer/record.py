@@ -77,6 +77,24 @@ class MissionRecord:
                 raise ValueError(f"{name}: expected shape {lead + n}, got {getattr(self, name).shape}")
         if self.range.shape != lead + n + (2,):
             raise ValueError(f"range: expected shape {lead + n + (2,)}, got {self.range.shape}")
+        self._check_bounds()
+
+    def _check_bounds(self) -> None:
+        """Reject intervals with a NaN or ``lo > hi``, bad cone geometry and non-increasing times."""
+        for name in ("speed", "yaw_rate", "heading", "range"):
+            v = getattr(self, name)
+            bad = np.isnan(v).any(axis=-1) | (v[..., 0] > v[..., 1])
+            if bad.any():
+                k = tuple(int(i) for i in np.argwhere(bad)[0])
+                raise ValueError(f"{name}: interval at index {k} is not [lo <= hi]: {v[k].tolist()}")
+        if not np.all(np.isfinite(self.t)):
+            raise ValueError("t: times must be finite")
+        if self.t.ndim == 1 and np.any(np.diff(self.t) <= 0):
+            raise ValueError("t: times must be strictly increasing")
+        if np.any(~(self.gamma > 0) | (self.gamma > np.pi)):
+            raise ValueError("gamma: cone half-apertures must be in (0, pi]")
+        if np.any(~(self.r_max > 0) | ~np.isfinite(self.r_max)):
+            raise ValueError("r_max: maximum ranges must be finite and > 0")
 
     @property
     def n_sensors(self) -> int:

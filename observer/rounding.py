@@ -31,6 +31,8 @@ __all__ = [
     "TWO_PI_UP",
     "next_down",
     "next_up",
+    "step_down",
+    "step_up",
     "widen_down",
     "widen_up",
     "add_down",
@@ -127,6 +129,31 @@ def _step(r: np.ndarray, mask: np.ndarray, up: bool) -> np.ndarray:
         if near.any():
             out = np.where(near, next_up(r) if up else next_down(r), out)
         return out
+
+
+def step_up(r: np.ndarray) -> np.ndarray:
+    """An upper bound of the exact value whose round-to-nearest result is ``r``.
+
+    For ``r`` the numpy result of one correctly rounded ``+ - * /`` or ``sqrt`` (within half an ulp of the
+    exact value), one ulp up bounds it: cheaper than :func:`add_up` and friends (no error-free
+    transformation) and at most one ulp looser. ``+inf`` stays; ``-inf`` (an overflow of a finite exact
+    value, or an infinite one) becomes ``-MAX``.
+    """
+    r = np.asarray(r, dtype=np.float64)
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = r + (np.abs(r) * _PHI + _ETA)
+    near = np.abs(r) < _NEAR_SUBNORMAL
+    if near.any():
+        out[near] = next_up(r[near])
+    inf = np.isinf(r)
+    if inf.any():
+        out[inf] = np.where(r[inf] > 0, _INF, -_MAX)
+    return out
+
+
+def step_down(r: np.ndarray) -> np.ndarray:
+    """A lower bound of the exact value whose round-to-nearest result is ``r`` (see :func:`step_up`)."""
+    return -step_up(-np.asarray(r, dtype=np.float64))
 
 
 def _direct(r: np.ndarray, err: np.ndarray, up: bool) -> np.ndarray:

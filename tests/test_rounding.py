@@ -311,3 +311,38 @@ def test_libm_within_libm_ulps(name):
     msg = f"{name}: max observed error {worst:.3f} ulps at {worst_at} (LIBM_ULPS = {rnd.LIBM_ULPS})"
     assert not bad, f"{msg}; {len(bad)} arguments outside the widened result, e.g. {bad[:3]}"
     assert worst <= rnd.LIBM_ULPS, msg
+
+
+@pytest.mark.parametrize("op", ["add", "sub", "mul", "div", "sqrt"])
+def test_step_bounds_round_to_nearest_results(op):
+    """step_down(fl(a op b)) <= a op b <= step_up(fl(a op b)), at most one ulp beyond the directed result."""
+    rng = np.random.default_rng(7)
+    a, b = random_floats(rng, 4000), random_floats(rng, 4000)
+    if op == "sqrt":
+        a = np.abs(a)
+    fn = {"add": np.add, "sub": np.subtract, "mul": np.multiply, "div": np.divide}.get(op)
+    with np.errstate(all="ignore"):
+        r = np.sqrt(a) if op == "sqrt" else fn(a, b)
+    lo, hi = rnd.step_down(r), rnd.step_up(r)
+    bad = []
+    for i in range(a.size):
+        x, y = float(a[i]), float(b[i])
+        if op == "sqrt":
+            if math.isinf(x):
+                continue
+            ex = mpmath.sqrt(mpmath.mpf(x))
+            ok = mpmath.mpf(float(lo[i])) <= ex <= mpmath.mpf(float(hi[i]))
+        else:
+            ex = exact_op(op, x, y)
+            if ex is None or isinstance(ex, float):
+                continue
+            ok = (lo[i] == -math.inf or Fraction(float(lo[i])) <= ex) and (
+                hi[i] == math.inf or ex <= Fraction(float(hi[i])))
+            if ok and abs(ex) <= MAX:
+                ok = lo[i] >= math.nextafter(directed(ex, False), -math.inf) and hi[i] <= math.nextafter(
+                    directed(ex, True), math.inf)
+        if not ok:
+            bad.append((x, y, float(r[i]), float(lo[i]), float(hi[i])))
+    assert not bad, f"{op}: {len(bad)} failures, first {bad[:3]}"
+    assert rnd.step_up(np.array([np.inf, -np.inf])).tolist() == [np.inf, -MAX]
+    assert rnd.step_down(np.array([np.inf, -np.inf])).tolist() == [MAX, -np.inf]

@@ -1,0 +1,128 @@
+"""Scripted missions with exact ground truth, for the offline observer (thesis §6.4.2).
+
+The robot follows a closed loop of waypoints with a pure-pursuit controller. Between two samples its
+speed ``v_k`` and yaw rate ``ω_k`` are constant, so the motion over ``[t_k, t_{k+1}]`` is an exact arc and
+its heading moves linearly from ``ψ_k`` to ``ψ_{k+1}``. This is the data contract the observer relies on:
+
+* ``speed[k]`` and ``yaw_rate[k]`` bound the true values over the whole slice ``[t_k, t_{k+1})``;
+* ``heading[k]`` bounds the true heading at ``t_k`` (a compass);
+* ``range[k]`` bounds the exact sonar / omnidirectional distances (:class:`~.sensors.SensorSuite`) at
+  the true pose ``k``.
+
+The truth is computed in float64: each arc is evaluated from the stored pose over the exact duration
+``t_{k+1} - t_k`` of the recorded times, and its own rounding (a few ulps per step, never accumulated
+because every step restarts from the stored pose) is covered by widening every interval by
+:data:`SIM_TOL` (relative, at least absolute). Under ``adversarial`` noise the truth therefore lies within
+``SIM_TOL`` of a bound rather than exactly on it.
+
+>>> rec, truth = loop_mission(duration=2.0, seed=0)
+>>> len(rec), truth.shape, bool(np.all(rec.range[:, 0, 0] <= rec.range[:, 0, 1]))
+(21, (21, 5), True)
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from digslam.observer.record import MissionRecord
+
+from .config import NoiseConfig
+from .generators import ThesisRoom
+from .sensors import SensorSuite, measure_step
+from .world import World
+
+#: A loop of waypoints inside the thesis room of Fig. 6.10 (at least 1.3 m from every wall).
+THESIS_LOOP = np.array(
+    [(0.0, 0.0), (3.0, -5.5), (6.5, -5.0), (5.0, -1.0), (4.0, 2.5), (6.5, 5.5), (4.0, 6.5), (0.5, 2.0),
+     (-3.0, 5.5), (-6.5, 5.5), (-5.5, 2.5), (-2.5, 0.5), (-6.5, -3.5), (-6.0, -6.5), (-2.0, -5.0)]
+)  # fmt: skip
+
+
+#: Relative (and absolute, below magnitude 1) widening that covers the generator's own float64 rounding.
+SIM_TOL = 1e-12
+
+
+def _pad(rec: MissionRecord) -> MissionRecord:
+    """Widen the interval fields by :data:`SIM_TOL`."""
+    d = rec.as_dict()
+    for name in ("speed", "yaw_rate", "heading", "range"):
+        v = d[name]
+        pad = SIM_TOL * np.maximum(1.0, np.abs(np.where(np.isfinite(v), v, 0.0)))
+        d[name] = np.stack([v[..., 0] - pad[..., 0], v[..., 1] + pad[..., 1]], axis=-1)
+    return MissionRecord(**d)
+
+
+def arc(pose: np.ndarray, v: float, w: float, dt: float) -> np.ndarray:
+    """Exact unicycle motion with constant ``(v, ω)`` over ``dt``."""
+    x, y, th = pose
+    if abs(w) < 1e-12:
+        return np.array([x + v * dt * math.cos(th), y + v * dt * math.sin(th), th])
+    th2 = th + w * dt
+    k = v / w
+    return np.array([x + k * (math.sin(th2) - math.sin(th)), y - k * (math.cos(th2) - math.cos(th)), th2])
+
+
+def loop_mission(
+    world: World | None = None,
+    waypoints: np.ndarray | None = None,
+    suite: SensorSuite | None = None,
+    duration: float = 1200.0,
+    dt: float = 0.1,
+    speed: float = 0.5,
+    max_yaw_rate: float = 0.6,
+    noise: NoiseConfig | None = None,
+    seed: int | None = 0,
+) -> tuple[MissionRecord, np.ndarray]:
+    """Simulate a loop mission and its bounded measurements.
+
+    Args:
+        world: the map (default: the thesis room of Fig. 6.10).
+        waypoints: ``(k, 2)`` closed loop of waypoints, the first one being the start (default
+            :data:`THESIS_LOOP`); the robot starts there heading to the second one.
+        suite: range sensors (default: one omnidirectional sensor of range 10 m, as in §6.4.2).
+        duration: mission length (s); ``round(duration / dt) + 1`` samples.
+        dt: sampling period (s).
+        speed: cruise speed (m/s).
+        max_yaw_rate: yaw-rate saturation of the controller (rad/s).
+        noise: error bounds and noise model (default: the thesis's 0.001 m/s, 0.001 rad, 0.01 m).
+        seed: seed of the noise draws.
+
+    Returns:
+        ``(record, truth)``: the stacked :class:`MissionRecord` and the truth ``(T+1, 5)``: pose
+        ``(x, y, ψ)`` at ``t_k`` and the constant ``(v, ω)`` over the slice that starts there.
+
+    Raises:
+        ValueError: on a non-positive ``dt``, ``duration`` or ``speed``, or too few waypoints.
+    """
+    if not (dt > 0 and duration > 0 and speed > 0 and max_yaw_rate > 0):
+        raise ValueError(f"dt, duration, speed, max_yaw_rate: must be > 0, got {dt}, {duration}, {speed}, "
+                         f"{max_yaw_rate}")
+    world = world if world is not None else ThesisRoom().generate(0)
+    wp = np.asarray(THESIS_LOOP if waypoints is None else waypoints, dtype=np.float64)
+    if wp.ndim != 2 or wp.shape[1] != 2 or len(wp) < 3:
+        raise ValueError(f"waypoints: expected (k >= 3, 2) points, got shape {wp.shape}")
+    suite = suite or SensorSuite(np.array([0.0]), np.array([math.pi]), np.array([10.0]))
+    noise = noise or NoiseConfig()
+    rng = np.random.default_rng(seed)
+    n = int(round(duration / dt))
+    d0 = wp[1] - wp[0]
+    pose = np.array([wp[0, 0], wp[0, 1], math.atan2(d0[1], d0[0])])
+    target, records, truth = 1, [], []
+    for k in range(n + 1):
+        to = wp[target] - pose[:2]
+        if np.hypot(*to) < 0.6:
+            target = (target + 1) % len(wp)
+            to = wp[target] - pose[:2]
+        err = (math.atan2(to[1], to[0]) - pose[2] + math.pi) % (2 * math.pi) - math.pi
+        w = float(np.clip(1.5 * err, -max_yaw_rate, max_yaw_rate))
+        v = speed * max(0.2, math.cos(err))
+        ranges = suite.true_ranges(world, pose)
+        records.append(_pad(measure_step(k * dt, suite, ranges, v, w, float(pose[2]), noise, rng)))
+        truth.append([*pose, v, w])
+        pose = arc(pose, v, w, (k + 1) * dt - k * dt)
+    return MissionRecord.stack(records), np.array(truth)
+
+
+__all__ = ["SIM_TOL", "THESIS_LOOP", "arc", "loop_mission"]

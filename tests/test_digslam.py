@@ -1,0 +1,120 @@
+"""Offline Dig-SLAM (thesis §6.4, Algorithm 6.3): guarantees against the simulator's ground truth."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from digslam.envs.config import NoiseConfig
+from digslam.envs.generators import ThesisRoom
+from digslam.envs.missions import arc, loop_mission
+from digslam.envs.sensors import SensorSuite
+from digslam.observer.digslam import DigSlamConfig, dig_slam
+from digslam.observer.grid import Grid
+from digslam.observer.record import MissionRecord
+
+CELL = 0.1
+GRID = Grid.from_cell_size((-10.0, -10.0), (10.0, 10.0), CELL)
+OMNI = SensorSuite(np.array([0.0]), np.array([math.pi]), np.array([10.0]))
+SONARS = SensorSuite(np.array([0.0, math.pi / 2, math.pi, -math.pi / 2]), np.full(4, math.pi / 12),
+                     np.full(4, 4.0))  # fmt: skip
+BOTH = SensorSuite(np.r_[SONARS.alpha, 0.0], np.r_[SONARS.gamma, math.pi], np.r_[SONARS.r_max, 5.0])
+
+
+def slice_points(truth: np.ndarray, dt: float, n: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """True positions at ``n`` times strictly inside every slice (exact arcs)."""
+    ts, xs = [], []
+    for j in range(1, n + 1):
+        tau = dt * j / (n + 1)
+        p = np.array([arc(truth[k, :3], truth[k, 3], truth[k, 4], tau) for k in range(len(truth) - 1)])
+        ts.append(np.arange(len(truth) - 1) * dt + tau)
+        xs.append(p[:, :2])
+    return np.concatenate(ts), np.concatenate(xs)
+
+
+def assert_dig_zone_free(free: np.ndarray, world: object, rng: np.random.Generator) -> None:
+    """No M⁻ cell meets an obstacle: exact raster, plus sampled points and corners of the cells."""
+    raster = np.flipud(world.raster(CELL))  # type: ignore[attr-defined]
+    assert raster.shape == free.shape
+    assert not np.any(free & (raster != 0)), "a dug cell is occupied or crossed by an edge"
+    rows, cols = np.nonzero(free)
+    pick = rng.choice(rows.size, min(rows.size, 3000), replace=False)
+    lo, hi = GRID.cell_boxes(rows[pick], cols[pick])
+    pts = np.concatenate([lo, hi, np.c_[lo[:, 0], hi[:, 1]], lo + (hi - lo) * rng.random(lo.shape)])
+    assert np.all(world.clearance(pts) > 0), "a point of a dug cell is not free"  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize(
+    ("suite", "model", "seed", "jitter"),
+    [(OMNI, "uniform", 0, 0.0), (OMNI, "adversarial", 1, 0.3), (BOTH, "uniform", 2, 0.2),
+     (SONARS, "adversarial", 3, 0.0), (BOTH, "biased", 4, 0.3)],
+)  # fmt: skip
+def test_guarantees_against_ground_truth(suite, model, seed, jitter):
+    world = ThesisRoom(jitter=jitter).generate(seed)
+    duration = 150.0 if suite is OMNI else 40.0  # sonar sectors cost more to dig
+    rec, truth = loop_mission(world, suite=suite, duration=duration, noise=NoiseConfig(model=model), seed=seed)
+    res = dig_slam(rec, GRID, truth[0, :2], truth[0, :2])
+    assert res.consistent and res.first_empty is None
+    tube = res.tube
+    # the true position is in the tube at every time: gates and inside every slice
+    assert np.all((tube.gate_lo <= truth[:, :2]) & (truth[:, :2] <= tube.gate_hi)), "truth left a gate"
+    ts, xs = slice_points(truth, 0.1)
+    assert np.all(tube.contains(ts, xs)), "truth left a slice"
+    assert np.all((tube.slice_lo <= xs[: len(truth) - 1]) & (xs[: len(truth) - 1] <= tube.slice_hi))
+    assert_dig_zone_free(res.dig.free, world, np.random.default_rng(seed))
+    assert res.dig.free.sum() * CELL**2 > 10.0  # it dug a real area
+
+
+def test_tube_shrinks_relative_to_dead_reckoning():
+    rec, truth = loop_mission(duration=400.0, seed=5)
+    res = dig_slam(rec, GRID, truth[0, :2], truth[0, :2])
+    assert res.consistent
+    final, dr = res.tube.widths(), res.dead_reckoning
+    assert final[-1] < 0.5 * dr[-1]
+    assert np.all(final <= dr + 1e-12)
+    assert len(res.widths) == res.iterations >= 2
+    no_impacts = dig_slam(rec, GRID, truth[0, :2], truth[0, :2], DigSlamConfig(impacts=False))
+    assert np.allclose(no_impacts.tube.widths(), dr)
+
+
+def test_inconsistent_reading_is_reported():
+    world = ThesisRoom().generate(0)
+    rec, truth = loop_mission(world, duration=60.0, seed=6)
+    d = rec.as_dict()
+    rng = d["range"].copy()
+    k = 300
+    rng[k, 0] = rng[k, 0] + 3.0  # reported 3 m farther than the truth: contradicts the neighbours
+    d["range"] = rng
+    bad = MissionRecord(**d)
+    res = dig_slam(bad, GRID, truth[0, :2], truth[0, :2])
+    assert not res.consistent
+    assert res.first_empty is not None and res.tube is None and res.dig is None
+
+
+def test_record_round_trip_gives_the_same_result(tmp_path):
+    rec, truth = loop_mission(duration=30.0, seed=7)
+    rec.save_npz(tmp_path / "mission.npz")
+    again = MissionRecord.load_npz(tmp_path / "mission.npz")
+    a = dig_slam(rec, GRID, truth[0, :2], truth[0, :2])
+    b = dig_slam(again, GRID, truth[0, :2], truth[0, :2])
+    assert np.array_equal(a.tube.gate_lo, b.tube.gate_lo) and np.array_equal(a.dig.free, b.dig.free)
+
+
+def test_bad_input():
+    rec, truth = loop_mission(duration=2.0, seed=0)
+    with pytest.raises(ValueError, match="x0_lo"):
+        dig_slam(rec, GRID, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    with pytest.raises(ValueError, match="x0_lo"):
+        dig_slam(rec, GRID, [1.0, 0.0], [0.0, 0.0])
+    with pytest.raises(ValueError, match="record"):
+        dig_slam(rec[0], GRID, [0.0, 0.0], [0.0, 0.0])
+    with pytest.raises(ValueError, match="max_iter"):
+        DigSlamConfig(max_iter=0)
+    with pytest.raises(ValueError, match="unknown"):
+        DigSlamConfig.from_dict({"max_iters": 3})
+    d = rec.as_dict()
+    d["range"] = d["range"][:, :, ::-1].copy()
+    with pytest.raises(ValueError, match="range"):
+        MissionRecord(**d)
