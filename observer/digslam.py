@@ -39,8 +39,10 @@ import numpy as np
 
 from . import rounding as rnd
 from .digmap import DigMap
+from .explored import explored_disks_grid, explored_union
 from .grid import Grid
 from .record import MissionRecord
+from .thick_sep import CLEAR, DARK, UNKNOWN
 from .tube import Tube, ctc_deriv, heading_from_compass, unicycle_velocity
 
 
@@ -53,11 +55,13 @@ class DigSlamConfig:
         tol: stop when an iteration shrinks the summed gate widths by less than this fraction.
         impacts: apply the impact contractor (Eq. 6.22); without it the result is dead reckoning plus
             digging (the thesis's "before contraction").
+        explored: compute the explored zone of the final tube (App. B).
     """
 
     max_iter: int = 10
     tol: float = 5e-3
     impacts: bool = True
+    explored: bool = True
 
     def __post_init__(self) -> None:
         if not (isinstance(self.max_iter, int) and self.max_iter >= 1):
@@ -84,6 +88,8 @@ class DigSlamResult:
         first_empty: index of the first empty gate, or None.
         tube: the contracted position tube (None when inconsistent).
         dig: the dig zone ``M⁻`` (None when inconsistent).
+        explored: the explored zone ``[Z⁻, Z⁺]`` on the grid (App. B), int8 codes of
+            :mod:`.thick_sep` (clear, penumbra, dark, unknown); None when inconsistent.
         heading: the heading tube used for the velocity (compass and gyro fused).
         iterations: fixpoint iterations run.
         widths: per iteration, gate widths ``(T+1,)`` before the impact contractor, after it, and after
@@ -99,6 +105,36 @@ class DigSlamResult:
     iterations: int
     widths: list[dict[str, np.ndarray]] = field(default_factory=list)
     dead_reckoning: np.ndarray | None = None
+    explored: np.ndarray | None = None
+
+
+def explored_zone(grid: Grid, record: MissionRecord, tube: Tube, heading: Tube) -> np.ndarray:
+    """Explored zone of the readings (App. B patches): each sensor saw up to its true range.
+
+    The visible set of a reading is the disk or sector of radius ``y ∈ [y⁻, y⁺]`` (``r_max`` exactly for
+    no echo) around the pose of the gate. Disks go through :func:`explored_disks_grid` (clear, penumbra
+    and dark proofs). Sectors take the fast sound path: clear where the cell is inside the sector of
+    radius ``y⁻`` for every pose and heading (:meth:`DigMap.dig_sectors`), dark where it is proved outside
+    the disk of radius ``y⁺`` around every pose, unknown elsewhere (the full sector tests of
+    :func:`.explored_sweep.explored_sectors_grid` prove penumbra too but cost far more per reading). The sensors' zones
+    are joined by :func:`explored_union`.
+    """
+    lo_r = record.range[..., 0]
+    hi_r = np.where(record.no_echo, record.r_max, record.range[..., 1])
+    parts = []
+    k, s = np.nonzero(record.gamma >= rnd.PI_DOWN)
+    if k.size:
+        parts.append(explored_disks_grid(grid, tube.gate_lo[k], tube.gate_hi[k], lo_r[k, s], hi_r[k, s]))
+    k, s = np.nonzero(record.gamma < rnd.PI_DOWN)
+    if k.size:
+        st = explored_disks_grid(grid, tube.gate_lo[k], tube.gate_hi[k], np.zeros(k.size), hi_r[k, s])
+        sure = DigMap(grid)
+        sure.dig_sectors(tube.gate_lo[k], tube.gate_hi[k], heading.gate_lo[k, 0], heading.gate_hi[k, 0],
+                         record.alpha[k, s], record.gamma[k, s], lo_r[k, s])  # fmt: skip
+        part = np.where(st == DARK, DARK, UNKNOWN).astype(np.int8)
+        part[sure.free] = CLEAR
+        parts.append(part)
+    return explored_union(parts)
 
 
 def dig_readings(
@@ -185,7 +221,9 @@ def dig_slam(
             break
         total = new_total
     res.tube = tube
+    if cfg.explored:
+        res.explored = explored_zone(grid, record, tube, heading)
     return res
 
 
-__all__ = ["DigSlamConfig", "DigSlamResult", "dig_readings", "dig_slam", "impact_bound"]
+__all__ = ["DigSlamConfig", "DigSlamResult", "dig_readings", "dig_slam", "explored_zone", "impact_bound"]

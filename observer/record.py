@@ -80,7 +80,7 @@ class MissionRecord:
         self._check_bounds()
 
     def _check_bounds(self) -> None:
-        """Reject intervals with a NaN or ``lo > hi``, bad cone geometry and non-increasing times."""
+        """Reject intervals with a NaN or ``lo > hi``, non-finite times and bad cone geometry."""
         for name in ("speed", "yaw_rate", "heading", "range"):
             v = getattr(self, name)
             bad = np.isnan(v).any(axis=-1) | (v[..., 0] > v[..., 1])
@@ -89,8 +89,6 @@ class MissionRecord:
                 raise ValueError(f"{name}: interval at index {k} is not [lo <= hi]: {v[k].tolist()}")
         if not np.all(np.isfinite(self.t)):
             raise ValueError("t: times must be finite")
-        if self.t.ndim == 1 and np.any(np.diff(self.t) <= 0):
-            raise ValueError("t: times must be strictly increasing")
         if np.any(~(self.gamma > 0) | (self.gamma > np.pi)):
             raise ValueError("gamma: cone half-apertures must be in (0, pi]")
         if np.any(~(self.r_max > 0) | ~np.isfinite(self.r_max)):

@@ -20,6 +20,7 @@ GRID = Grid.from_cell_size((-10.0, -10.0), (10.0, 10.0), CELL)
 OMNI = SensorSuite(np.array([0.0]), np.array([math.pi]), np.array([10.0]))
 SONARS = SensorSuite(np.array([0.0, math.pi / 2, math.pi, -math.pi / 2]), np.full(4, math.pi / 12),
                      np.full(4, 4.0))  # fmt: skip
+WORLDS: dict[int, object] = {}  # the world of each mission record, for the ground truth
 BOTH = SensorSuite(np.r_[SONARS.alpha, 0.0], np.r_[SONARS.gamma, math.pi], np.r_[SONARS.r_max, 5.0])
 
 
@@ -55,6 +56,7 @@ def test_guarantees_against_ground_truth(suite, model, seed, jitter):
     world = ThesisRoom(jitter=jitter).generate(seed)
     duration = 150.0 if suite is OMNI else 40.0  # sonar sectors cost more to dig
     rec, truth = loop_mission(world, suite=suite, duration=duration, noise=NoiseConfig(model=model), seed=seed)
+    WORLDS[id(rec)] = world
     res = dig_slam(rec, GRID, truth[0, :2], truth[0, :2])
     assert res.consistent and res.first_empty is None
     tube = res.tube
@@ -65,6 +67,49 @@ def test_guarantees_against_ground_truth(suite, model, seed, jitter):
     assert np.all((tube.slice_lo <= xs[: len(truth) - 1]) & (xs[: len(truth) - 1] <= tube.slice_hi))
     assert_dig_zone_free(res.dig.free, world, np.random.default_rng(seed))
     assert res.dig.free.sum() * CELL**2 > 10.0  # it dug a real area
+    assert_explored_sound(res.explored, rec, truth, suite, np.random.default_rng(seed))
+
+
+def truly_sensed(p: np.ndarray, rec: MissionRecord, truth: np.ndarray, suite: SensorSuite) -> np.ndarray:
+    """Points ``(P, 2)`` inside some true visible set: within the true range, in the true cone."""
+    true_r = np.array([suite.true_ranges(WORLDS[id(rec)], pose) for pose in truth[:, :3]])
+    true_r = np.where(np.isfinite(true_r), true_r, suite.r_max)  # (T, S)
+    d = p[:, None, :] - truth[None, :, :2]  # (P, T, 2)
+    rho = np.linalg.norm(d, axis=-1)
+    ang = np.arctan2(d[..., 1], d[..., 0])
+    seen = np.zeros(p.shape[0], dtype=bool)
+    for s in range(suite.n):
+        diff = np.abs((ang - truth[None, :, 2] - suite.alpha[s] + np.pi) % (2 * np.pi) - np.pi)
+        seen |= ((rho <= true_r[None, :, s]) & (diff <= suite.gamma[s])).any(axis=1)
+    return seen
+
+
+def assert_explored_sound(st: np.ndarray, rec: MissionRecord, truth: np.ndarray, suite: SensorSuite,
+                          rng: np.random.Generator) -> None:  # fmt: skip
+    """Clear cells were truly sensed, dark cells never; every truly sensed point is in a non-dark cell."""
+    from digslam.observer.thick_sep import CLEAR, DARK
+
+    for code, want in ((CLEAR, True), (DARK, False)):
+        rows, cols = np.nonzero(st == code)
+        if rows.size == 0:
+            continue
+        pick = rng.choice(rows.size, min(rows.size, 150), replace=False)
+        lo, hi = GRID.cell_boxes(rows[pick], cols[pick])
+        pts = np.concatenate([lo + (hi - lo) * rng.random(lo.shape), lo, hi])
+        assert np.all(truly_sensed(pts, rec, truth, suite) == want), f"a {code} cell is wrong"
+    # truly sensed points: from random true poses, inside the true cone and range
+    k = rng.integers(0, len(truth), 300)
+    s = rng.integers(0, suite.n, 300)
+    true_r = np.array([suite.true_ranges(WORLDS[id(rec)], truth[i, :3])[j] for i, j in zip(k, s)])
+    rr = np.where(np.isfinite(true_r), true_r, suite.r_max[s]) * rng.random(300)
+    th = truth[k, 2] + suite.alpha[s] + suite.gamma[s] * rng.uniform(-1, 1, 300)
+    p = truth[k, :2] + rr[:, None] * np.c_[np.cos(th), np.sin(th)]
+    inside = np.all((p > GRID.lo) & (p < GRID.hi), axis=1)
+    lo, hi = GRID.cell_boxes()
+    p = p[inside]
+    col = np.searchsorted(GRID.xs, p[:, 0]) - 1
+    row = np.searchsorted(-GRID.ys, -p[:, 1]) - 1
+    assert np.all(st[row, col] != DARK), "a truly sensed point lies in a dark cell"
 
 
 def test_tube_shrinks_relative_to_dead_reckoning():
