@@ -61,9 +61,20 @@ from .sep_polygon import CtcPolygonBoundary, CtcSegments, SepPolygon
 from .separators import Sep, SepBox, SepInter, SepNot, SepQInter, SepUnion
 from .shapes import free_zone, impact_zone, measurement_shapes
 from .subpaving import SepSubpaving, load, save, simplify
+from .thick_carving import (
+    SRACResult,
+    ctc_image_equal,
+    ctc_image_param,
+    ctc_param_equal,
+    ctc_param_meets,
+    ctc_param_subset,
+    param_hull,
+    srac,
+)
 from .thick_function import ThickFunction
 from .thick_interval import ThickIntervalArray, thin
 from .thick_inversion import SepFixedParam, thick_inverse_classical, thick_inverse_proj
+from .thick_ops import thick_image, thick_image_param, thick_minkowski_sum, thick_product
 from .thick_paver import ThickPaving, ThickTest, thick_pave
 from .thick_sep import (
     CLEAR,
@@ -106,6 +117,9 @@ __all__ = [
     "explored_thick_sep", "explored_union", "explored_sectors_grid", "explored_sweep_grid", "sweep_gates",
     "CtcLandmarks", "IterationStats", "Localization", "contract_detections", "contract_disjunctive",
     "localize", "free_zone", "impact_zone", "measurement_shapes",
+    "SRACResult", "ctc_image_equal", "ctc_image_param", "ctc_param_equal", "ctc_param_meets",
+    "ctc_param_subset", "param_hull", "srac", "thick_image", "thick_image_param", "thick_minkowski_sum",
+    "thick_product",
     "CLEAR", "DARK", "PENUMBRA", "UNKNOWN", "ThickSep", "thick_classify_grid", "thick_relaxed_intersection",
     "ctc_equal", "ctc_subset", "ThickFunction", "ThickIntervalArray", "thin",
     "SepSubpaving", "load", "save", "simplify",

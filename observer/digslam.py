@@ -116,8 +116,8 @@ def explored_zone(grid: Grid, record: MissionRecord, tube: Tube, heading: Tube) 
     and dark proofs). Sectors take the fast sound path: clear where the cell is inside the sector of
     radius ``y⁻`` for every pose and heading (:meth:`DigMap.dig_sectors`), dark where it is proved outside
     the disk of radius ``y⁺`` around every pose, unknown elsewhere (the full sector tests of
-    :func:`.explored_sweep.explored_sectors_grid` prove penumbra too but cost far more per reading). The sensors' zones
-    are joined by :func:`explored_union`.
+    :func:`.explored_sweep.explored_sectors_grid` prove penumbra too but cost far more per reading).
+    The sensors' zones are joined by :func:`explored_union`.
     """
     lo_r = record.range[..., 0]
     hi_r = np.where(record.no_echo, record.r_max, record.range[..., 1])
