@@ -32,6 +32,7 @@ from .landmarks import (
     localize,
 )
 from .minkowski import SepMinkowskiDiff, SepMinkowskiSum, sep_negate
+from .online import OnlineConfig, OnlineDigSlam
 from .ops import abs_, acos, asin, atan, atan2, cos, exp, log, maximum, minimum, pown, sin, sqr, sqrt, tan
 from .paver import Paving, PavingTree, classify_grid, pave
 from .polar_ctc import CtcPolar
@@ -119,7 +120,7 @@ __all__ = [
     "localize", "free_zone", "impact_zone", "measurement_shapes",
     "SRACResult", "ctc_image_equal", "ctc_image_param", "ctc_param_equal", "ctc_param_meets",
     "ctc_param_subset", "param_hull", "srac", "thick_image", "thick_image_param", "thick_minkowski_sum",
-    "thick_product",
+    "thick_product", "OnlineConfig", "OnlineDigSlam",
     "CLEAR", "DARK", "PENUMBRA", "UNKNOWN", "ThickSep", "thick_classify_grid", "thick_relaxed_intersection",
     "ctc_equal", "ctc_subset", "ThickFunction", "ThickIntervalArray", "thin",
     "SepSubpaving", "load", "save", "simplify",

@@ -1,0 +1,282 @@
+"""Online guaranteed Dig-SLAM: Algorithm 6.3 (thesis §6.4, Eq. 6.21–6.23) run as a filter, one step at a time.
+
+Each :meth:`OnlineDigSlam.update` takes the next single-step record and
+
+1. predicts ``ψ_k ∈ [ψ_{k-1}] + [dt]·[ω_{k-1}]`` (intersected with the compass) and the heading over the
+   slice, then ``x_k ∈ x_{k-1} + [dt]·[v_{k-1}] (cos, sin)([ψ] on the slice)`` (Eq. 6.23; the previous
+   record's speed and yaw rate bound the truth over the slice: data contract of
+   :mod:`digslam.envs.missions`); scalar outward rounding, each correctly rounded operation is stepped one
+   ulp outward (``math.nextafter``), ``cos``/``sin`` widened by more than :data:`~.rounding.LIBM_ULPS`;
+2. contracts the box with the impacts ``dist(x_k, comp M⁻) <= y⁺`` (Eq. 6.22) on a window;
+3. digs ``M⁻ := M⁻ ∪ g⁻¹_{[x_k]}(Z⁻)`` (Eq. 6.21) and grows the explored zone: certainly sensed =
+   dug, possibly sensed = not proved outside every sensed sector (:mod:`.online_explored`);
+4. optionally (``smoothing_window = W``) contracts the last ``W`` boxes backward,
+   ``x_j &= x_{j+1} - [d_j]``, and digs again the readings of the boxes that shrank.
+
+State is a fixed set of arrays (plus a ring of ``W`` steps): memory does not grow with the episode.
+An empty box means the data contradict their bounds: the filter says so and stops (never a false claim).
+
+>>> from digslam.observer.record import MissionRecord
+>>> def step(k):
+...     return MissionRecord(t=0.1 * k, speed=[0.99, 1.01], yaw_rate=[-0.01, 0.01], heading=[-1e-3, 1e-3],
+...         alpha=[0.0], gamma=[np.pi], r_max=[5.0], range=[[1.99 - 0.1 * k, 2.01 - 0.1 * k]],
+...         no_echo=[False], outlier=[False])                                     # a wall at x = 2
+>>> f = OnlineDigSlam(Grid((-3.0, -3.0), (3.0, 3.0), (60, 60)))
+>>> f.reset([0.0, 0.0], [0.0, 0.0], step(0))
+>>> for k in range(1, 6):
+...     f.update(step(k))
+>>> f.consistent, f.steps, bool(f.pose_lo[0] <= 0.5 <= f.pose_hi[0]), bool(f.dig.free[30, 52])
+(True, 6, True, False)
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import deque
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from . import rounding as rnd
+from .grid import Grid
+from .online_explored import WindowDigMap, mark_possibly_sensed
+from .record import MissionRecord
+from .thick_sep import CLEAR, DARK, PENUMBRA
+
+__all__ = ["OnlineConfig", "OnlineDigSlam"]
+
+_INF = math.inf
+#: Absolute widening of a libm ``cos``/``sin`` value (``|v| <= 1``): 4 ulps of 1 plus the subtraction's.
+_TRIG_PAD = 2e-15
+
+
+def _up(x: float) -> float:
+    return math.nextafter(x, _INF)
+
+
+def _dn(x: float) -> float:
+    return math.nextafter(x, -_INF)
+
+
+def _mul(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
+    """Outward-rounded product of two finite intervals."""
+    p = (al * bl, al * bh, ah * bl, ah * bh)
+    return _dn(min(p)), _up(max(p))
+
+
+def _cos_sin(a: float, b: float) -> tuple[float, float, float, float]:
+    """Enclosures ``(cos⁻, cos⁺, sin⁻, sin⁺)`` over ``[a, b]``: endpoints widened, plus every extremum
+    ``m·π/2`` that may lie in ``[a, b]`` (slack on the float multiple of ``π/2``)."""
+    m0, m1 = math.floor(a / rnd.HALF_PI_UP) - 1, math.floor(b / rnd.HALF_PI_DOWN) + 1
+    if m1 - m0 > 8:
+        return -1.0, 1.0, -1.0, 1.0
+    ca, cb, sa, sb = math.cos(a), math.cos(b), math.sin(a), math.sin(b)
+    c = [min(ca, cb) - _TRIG_PAD, max(ca, cb) + _TRIG_PAD, min(sa, sb) - _TRIG_PAD, max(sa, sb) + _TRIG_PAD]
+    for m in range(m0, m1 + 1):
+        p = m * rnd.HALF_PI_DOWN
+        eps = abs(p) * 1e-15 + 1e-300
+        if a - eps <= p <= b + eps:
+            c[(1, 3, 0, 2)[m % 4]] = (1.0, 1.0, -1.0, -1.0)[m % 4]  # cos max, sin max, cos min, sin min
+    return max(c[0], -1.0), min(c[1], 1.0), max(c[2], -1.0), min(c[3], 1.0)
+
+
+@dataclass(frozen=True)
+class OnlineConfig:
+    """Settings of :class:`OnlineDigSlam`.
+
+    Attributes:
+        smoothing_window: fixed-lag backward smoothing over the last ``W`` steps (0 = off).
+        impacts: apply the impact contractor (Eq. 6.22).
+    """
+
+    smoothing_window: int = 0
+    impacts: bool = True
+
+    def __post_init__(self) -> None:
+        w = self.smoothing_window
+        if not (isinstance(w, int | np.integer) and not isinstance(w, bool) and w >= 0):
+            raise ValueError(f"smoothing_window: must be an integer >= 0, got {w!r}")
+        if not isinstance(self.impacts, bool | np.bool_):
+            raise ValueError(f"impacts: must be a bool, got {self.impacts!r}")
+
+    @classmethod
+    def from_dict(cls, data: Any) -> OnlineConfig:
+        """Build from a mapping; an unknown key raises ``ValueError`` naming it."""
+        unknown = sorted(set(data) - set(cls.__dataclass_fields__))
+        if unknown:
+            known = sorted(cls.__dataclass_fields__)
+            raise ValueError(f"OnlineConfig: unknown key(s) {unknown}; known: {known}")
+        return cls(**dict(data))
+
+
+class OnlineDigSlam:
+    """The online Dig-SLAM filter (see the module docstring).
+
+    Args:
+        grid: the cells of ``M⁻`` and of the explored zone (they must cover what the robot senses).
+        config: :class:`OnlineConfig` (defaults when None).
+
+    Attributes:
+        pose_lo, pose_hi: ``(2,)`` position box at the last step (``[+inf, -inf]`` once inconsistent).
+        heading_lo, heading_hi: heading interval at the last step.
+        dig: the dig zone ``M⁻`` (:class:`~.online_explored.WindowDigMap`; ``dig.free`` bool ``(ny, nx)``).
+        sensed_sure, sensed_maybe: ``(ny, nx)`` bool, certainly / possibly sensed cells.
+        consistent, inconsistent_step: False and the step index (``reset`` is step 0) once the data
+            contradicted their bounds; the sets then carry no guarantee and ``update`` does nothing.
+        steps: steps folded in (``reset`` counts one); last_update_seconds: wall time of the last update.
+    """
+
+    def __init__(self, grid: Grid, config: OnlineConfig | None = None) -> None:
+        if not isinstance(grid, Grid):
+            raise ValueError(f"grid: expected a Grid, got {type(grid).__name__}")
+        if config is not None and not isinstance(config, OnlineConfig):
+            raise ValueError(f"config: expected an OnlineConfig, got {type(config).__name__}")
+        self.grid, self.config = grid, config or OnlineConfig()
+        self._ring: deque = deque(maxlen=self.config.smoothing_window + 1)
+        self._blank()
+
+    def _blank(self) -> None:
+        self.pose_lo, self.pose_hi = np.full(2, _INF), np.full(2, -_INF)
+        self.heading_lo, self.heading_hi = _INF, -_INF
+        self.dig = WindowDigMap(self.grid)
+        self.sensed_sure = np.zeros(self.grid.shape, dtype=bool)
+        self.sensed_maybe = np.zeros(self.grid.shape, dtype=bool)
+        self.consistent, self.inconsistent_step = False, None
+        self.steps, self.last_update_seconds = 0, 0.0
+        self._prev: MissionRecord | None = None
+        self._ring.clear()
+
+    def _check_record(self, rec: Any, name: str = "rec") -> MissionRecord:
+        if not isinstance(rec, MissionRecord) or rec.t.ndim != 0:
+            raise ValueError(f"{name}: expected a single-step MissionRecord (scalar t)")
+        if name == "rec" and self._prev is not None:
+            if rec.n_sensors != self._prev.n_sensors:
+                n = self._prev.n_sensors
+                raise ValueError(f"{name}: {rec.n_sensors} sensors, the episode started with {n}")
+            if not float(rec.t) > float(self._prev.t):
+                raise ValueError(f"{name}: time {float(rec.t)} does not follow {float(self._prev.t)}")
+        return rec
+
+    def reset(self, x0_lo: Any, x0_hi: Any, first: MissionRecord) -> None:
+        """Start an episode from the box ``X₀`` (Eq. 6.15) and the record at ``t_0``."""
+        lo, hi = np.array(x0_lo, dtype=np.float64).ravel(), np.array(x0_hi, dtype=np.float64).ravel()
+        g = self.grid
+        if lo.shape != (2,) or hi.shape != (2,) or not (np.isfinite(lo).all() and np.isfinite(hi).all()):
+            raise ValueError(f"x0_lo, x0_hi: expected a finite 2-d box, got {x0_lo} and {x0_hi}")
+        if np.any(lo > hi) or np.any(lo < g.lo) or np.any(hi > g.hi):
+            raise ValueError(f"x0_lo, x0_hi: expected lo <= hi inside the grid's frame, got {lo} and {hi}")
+        first = self._check_record(first, "first")
+        self._blank()
+        self.pose_lo, self.pose_hi = lo, hi
+        self.heading_lo, self.heading_hi = float(first.heading[0]), float(first.heading[1])
+        self.consistent = True
+        self._measure(first, None)
+
+    def update(self, rec: MissionRecord) -> None:
+        """Fold in the next single-step record (does nothing once inconsistent)."""
+        if self._prev is None:
+            raise ValueError("rec: call reset() before update()")
+        rec = self._check_record(rec)
+        if not self.consistent:
+            return
+        start = time.perf_counter()
+        p = self._prev
+        dt = float(rec.t) - float(p.t)
+        dtl, dth = _dn(dt), _up(dt)
+        # heading (compass fused with the gyro, Eq. 6.12) and its slice
+        wl, wh = _mul(dtl, dth, float(p.yaw_rate[0]), float(p.yaw_rate[1]))
+        h0l, h0h = self.heading_lo, self.heading_hi
+        hl, hh = max(float(rec.heading[0]), _dn(h0l + wl)), min(float(rec.heading[1]), _up(h0h + wh))
+        zl, zh = min(wl, 0.0), max(wh, 0.0)
+        sl, sh = max(_dn(h0l + zl), _dn(hl - zh)), min(_up(h0h + zh), _up(hh - zl))
+        if not (hl <= hh and sl <= sh):
+            return self._fail(start)
+        # position (Eq. 6.23): x_k = x_{k-1} + [dt]·[v]·(cos, sin)[ψ]
+        cl, ch, snl, snh = _cos_sin(sl, sh)
+        vl, vh = float(p.speed[0]), float(p.speed[1])
+        d = [_mul(dtl, dth, *_mul(vl, vh, cl, ch)), _mul(dtl, dth, *_mul(vl, vh, snl, snh))]
+        lo = np.array([_dn(float(self.pose_lo[i]) + d[i][0]) for i in (0, 1)])
+        hi = np.array([_up(float(self.pose_hi[i]) + d[i][1]) for i in (0, 1)])
+        self.heading_lo, self.heading_hi = hl, hh
+        if self.config.impacts:
+            lo, hi = self.dig.contract_box(lo, hi, self._impact_bound(rec))
+        if not np.all(lo <= hi):
+            return self._fail(start)
+        self.pose_lo, self.pose_hi = lo, hi
+        self._measure(rec, np.array([d[0][0], d[1][0], d[0][1], d[1][1]]))
+        if self.config.smoothing_window and not self._smooth():
+            return self._fail(start)
+        self.last_update_seconds = time.perf_counter() - start
+        return None
+
+    # ------------------------------------------------------------------ internals
+    @staticmethod
+    def _impact_bound(rec: MissionRecord) -> float:
+        """Smallest upper range bound over the echoing sensors (``inf`` if none echoed)."""
+        return float(np.min(np.where(rec.no_echo, _INF, rec.range[:, 1]), initial=_INF))
+
+    def _fail(self, start: float) -> None:
+        self.consistent, self.inconsistent_step = False, self.steps
+        self.pose_lo, self.pose_hi = np.full(2, _INF), np.full(2, -_INF)
+        self.heading_lo, self.heading_hi = _INF, -_INF
+        self.steps += 1
+        self.last_update_seconds = time.perf_counter() - start
+
+    def _dig(self, rec: MissionRecord, lo: np.ndarray, hi: np.ndarray, psi: tuple[float, float]) -> None:
+        """Eq. 6.21 for the readings of one step; the dug cells are certainly sensed (radius ``<= r_max``)."""
+        r = np.minimum(rec.range[:, 0], rec.r_max)
+        ok = np.isfinite(r) & (r > 0)
+        omni = ok & (rec.gamma >= rnd.PI_DOWN)
+        cone = ok & ~omni
+        if omni.any():
+            n = int(omni.sum())
+            self.dig.dig_disks(np.tile(lo, (n, 1)), np.tile(hi, (n, 1)), r[omni])
+        if cone.any():
+            n = int(cone.sum())
+            self.dig.dig_sectors(np.tile(lo, (n, 1)), np.tile(hi, (n, 1)), np.full(n, psi[0]),
+                                 np.full(n, psi[1]), rec.alpha[cone], rec.gamma[cone], r[cone])  # fmt: skip
+        reach = float(np.max(rec.r_max))
+        r0, r1, c0, c1 = self.dig.win(lo - reach, hi + reach)
+        self.sensed_sure[r0:r1, c0:c1] |= self.dig.free[r0:r1, c0:c1]
+
+    def _measure(self, rec: MissionRecord, d: np.ndarray | None) -> None:
+        """Dig the readings of the current step and grow the possibly sensed zone; push the step."""
+        psi = (self.heading_lo, self.heading_hi)
+        self._dig(rec, self.pose_lo, self.pose_hi, psi)
+        r_plus = np.minimum(rec.range[:, 1], rec.r_max)
+        mark_possibly_sensed(self.grid, self.sensed_maybe, self.pose_lo, self.pose_hi, psi[0], psi[1],
+                             rec.alpha, rec.gamma, r_plus)  # fmt: skip
+        if self.config.smoothing_window:
+            self._ring.append([rec, self.pose_lo.copy(), self.pose_hi.copy(), psi, d])
+        self._prev = rec
+        self.steps += 1
+
+    def _smooth(self) -> bool:
+        """Backward pass ``x_j &= x_{j+1} - [d_j]`` over the ring; digs again the boxes that shrank."""
+        ring = list(self._ring)
+        for j in range(len(ring) - 2, -1, -1):
+            _, lo, hi, psi, _ = ring[j]
+            d = ring[j + 1][4]
+            nlo = np.maximum(lo, rnd.step_down(ring[j + 1][1] - d[2:]))
+            nhi = np.minimum(hi, rnd.step_up(ring[j + 1][2] - d[:2]))
+            if not np.all(nlo <= nhi):
+                return False
+            if np.array_equal(nlo, lo) and np.array_equal(nhi, hi):
+                break
+            ring[j][1], ring[j][2] = nlo, nhi
+            self._dig(ring[j][0], nlo, nhi, psi)
+        return True
+
+    # ------------------------------------------------------------------ outputs
+    def explored(self) -> np.ndarray:
+        """``(ny, nx)`` int8: CLEAR (certainly sensed), PENUMBRA (possibly), DARK (certainly not)."""
+        out = np.full(self.grid.shape, DARK, dtype=np.int8)
+        out[self.sensed_maybe] = PENUMBRA
+        out[self.sensed_sure] = CLEAR
+        return out
+
+    def clear_mask(self) -> np.ndarray:
+        """Certified coverage: proved free and certainly explored."""
+        return self.sensed_sure & self.dig.free
