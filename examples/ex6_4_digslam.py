@@ -3,8 +3,8 @@
 A robot loops for 20 minutes in the polygon room of Fig. 6.10 (frame [-10, 10]²), measuring its speed
 (±0.001 m/s), its heading (±0.001 rad), its yaw rate (±0.001 rad/s) and the distance to the nearest
 obstacle (±0.01 m) every 0.1 s; its initial position is known. Dig-SLAM (Algorithm 6.3) runs to its
-fixpoint and draws the tube and the dig zone ``M⁻`` against the true map (Fig. 6.12), and the tube width
-over time for dead reckoning and for each iteration (Fig. 6.13).
+fixpoint and draws the tube, the dig zone ``M⁻`` against the true map and the explored zone (Fig. 6.12),
+and the tube width over time for dead reckoning and for each iteration (Fig. 6.13).
 
 Usage: ``python examples/ex6_4_digslam.py [--out DIR] [--duration S] [--cell M] [--seed N]``.
 """
@@ -40,6 +40,8 @@ def run(duration: float = 1200.0, cell: float = 0.05, seed: int = 0, out: str | 
         "mean_width": float(res.tube.widths().mean()),
         "dig_area": float(res.dig.free.sum() * np.prod(grid.cell_size)),
         "truth_in_tube": bool(inside.all()),
+        "clear_area": float((res.explored == 1).sum() * np.prod(grid.cell_size)),
+        "penumbra_area": float((res.explored == 2).sum() * np.prod(grid.cell_size)),
     }
     if out is not None:
         draw(res, world, truth, grid, Path(out))
@@ -55,7 +57,9 @@ def draw(res: DigSlamResult, world: object, truth: np.ndarray, grid: Grid, out: 
     from matplotlib.collections import PolyCollection
 
     out.mkdir(parents=True, exist_ok=True)
-    fig, (a, b) = plt.subplots(1, 2, figsize=(13, 6.2))
+    from digslam.observer.draw import draw_grid
+
+    fig, (a, b, c) = plt.subplots(1, 3, figsize=(19, 6.2))
     rings = [np.vstack([r, r[:1]]) for r in world.rings]  # type: ignore[attr-defined]
     k = np.arange(0, res.tube.T + 1, 20)
     lo, hi = res.tube.gate_lo[k], res.tube.gate_hi[k]
@@ -65,7 +69,9 @@ def draw(res: DigSlamResult, world: object, truth: np.ndarray, grid: Grid, out: 
     a.set_title(f"tube (every 2 s), {res.iterations} iterations")
     b.imshow(res.dig.free, extent=grid.extent, cmap="Reds", vmin=0, vmax=1.6, interpolation="nearest")
     b.set_title("dig zone $M^-$ (red) and the true map")
-    for ax in (a, b):
+    draw_grid(res.explored, grid.extent, ax=c, thick=True, penumbra=2)
+    c.set_title("explored zone: clear red, penumbra orange, dark blue")
+    for ax in (a, b, c):
         for r in rings:
             ax.plot(r[:, 0], r[:, 1], "k", lw=1.0)
         ax.set_xlim(-10, 10)
