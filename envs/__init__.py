@@ -1,8 +1,10 @@
 """digslam.envs: simulator, Gymnasium environments and the observer wrapper.
 
 Importing this package registers ``digslam/Explore-v0`` (the thesis room of Fig. 6.10) and its variants
-(:data:`ENV_IDS`). In worker processes that have not imported it (e.g. SB3's ``SubprocVecEnv`` with
-forkserver), use the ``"digslam.envs:digslam/Explore-v0"`` form, which imports the module first.
+(:data:`ENV_IDS`), and the certified-coverage ``digslam/DigCoverage-v0`` and its variants
+(:data:`COVERAGE_IDS`: omni-only, sonar-only, large caves, adversarial noise). In worker processes that
+have not imported it (e.g. SB3's ``SubprocVecEnv`` with forkserver), use the
+``"digslam.envs:digslam/Explore-v0"`` form, which imports the module first.
 """
 
 from __future__ import annotations
@@ -28,16 +30,50 @@ ENV_IDS: dict[str, dict[str, object]] = {
     "digslam/ExploreOutliers-v0": {"world": "rocks", "noise": {"outlier_prob": 0.05}},
 }
 
-for _id, _kw in ENV_IDS.items():
-    if _id not in gym.registry:
-        gym.register(
-            id=_id,
-            entry_point="digslam.envs.explore_env:ExploreEnv",
-            kwargs=dict(_kw),
-            max_episode_steps=MAX_EPISODE_STEPS,
-        )
+#: Certified-coverage ids (``DigCoverageEnv``: the raw env under the guaranteed observer) and their kwargs.
+COVERAGE_IDS: dict[str, dict[str, object]] = {
+    "digslam/DigCoverage-v0": {},
+    "digslam/DigCoverageOmni-v0": {"n_sonars": 0},
+    "digslam/DigCoverageSonar-v0": {"omni": False},
+    "digslam/DigCoverageCaves-v0": {"world": "caves", "world_size": 20.0},
+    "digslam/DigCoverageAdversarial-v0": {"noise": {"model": "adversarial"}},
+}
+
+for _ids, _entry in (
+    (ENV_IDS, "digslam.envs.explore_env:ExploreEnv"),
+    (COVERAGE_IDS, "digslam.envs.dig_coverage:DigCoverageEnv"),
+):
+    for _id, _kw in _ids.items():
+        if _id not in gym.registry:
+            gym.register(id=_id, entry_point=_entry, kwargs=dict(_kw), max_episode_steps=MAX_EPISODE_STEPS)
+
+#: Names of the observer side, imported on first use (they need ``digslam.observer.online`` and scipy).
+_LAZY = {
+    "DigCoverageEnv": "dig_coverage",
+    "DigCoverageConfig": "observer_config",
+    "ObserverConfig": "observer_config",
+    "GuaranteedObserver": "observer_wrapper",
+    "GuaranteeMonitor": "monitor",
+    "GuaranteeViolation": "monitor",
+}
+
+
+def __getattr__(name: str) -> object:
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
+    "COVERAGE_IDS",
+    "DigCoverageConfig",
+    "DigCoverageEnv",
+    "GuaranteeMonitor",
+    "GuaranteeViolation",
+    "GuaranteedObserver",
+    "ObserverConfig",
     "ENV_IDS",
     "Caves",
     "Episode",

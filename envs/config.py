@@ -116,14 +116,14 @@ class ExploreConfig(_Config):
         n_obstacles: Number of rocks (``world='rocks'``).
         map_path: Polygon (``.json``/``.npz``) or image file for ``world="file"``.
         fixed_world: Keep the world of the first reset (True) or draw a new one at each reset.
-        robot_radius: Robot disc radius (m); collisions use it plus a skin of
-            ``1.5 * max_speed * dt / substeps`` so that the disc never overlaps a wall.
+        robot_radius: Robot disc radius (m); the kinematics (:mod:`.robot`) keep this disc off every wall.
+            Start poses keep ``1.5 * robot_radius`` plus a skin of ``1.5 * max_speed * dt / substeps``.
         max_speed: Speed for a normalised action of 1 (m/s).
         max_yaw_rate: Yaw rate for a normalised action of 1 (rad/s).
         dt: Step duration (s).
-        substeps: Physics substeps per step.
-        max_force: Force limit of the drive joint (N); finite, so walls win.
-        max_torque: Torque limit of the steering joint (N m).
+        substeps: Physics substeps per step (each one exact arc, possibly slowed or stopped by a wall).
+        max_force: Force limit of the drive joint of the pymunk reference loop (N; benchmarks only).
+        max_torque: Torque limit of its steering joint (N m).
         n_sonars: Number of sonar cones, evenly spread around the heading.
         sonar_gamma: Half-aperture of each cone (rad), in (0, pi].
         sonar_range: Maximum sonar range (m).

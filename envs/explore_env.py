@@ -1,10 +1,23 @@
 """``digslam/Explore-v0``: a disc robot with exact sonar cones exploring an unknown world.
 
 Action: normalised ``(v, omega)`` in ``[-1, 1]^2``. Observation (dict): range intervals ``ranges (n, 2)``
-(``[r_max, top]`` where no echo), ``no_echo (n,)``, ``odometry (2, 2)`` (speed and yaw-rate intervals) and
-``heading (2,)`` (compass interval, shifted by a multiple of 2 pi into about ``[-pi, pi]``). Reward: the newly
-and truly sensed free area (m^2). ``info`` holds the :class:`~digslam.observer.record.MissionRecord` under
-``"record"`` and the :class:`~digslam.envs.episode.GroundTruth` under ``"truth"``.
+(``[r_max, top]`` where no echo), ``no_echo (n,)``, ``odometry (2, 2)`` (speed and yaw-rate intervals over
+the step just ended) and ``heading (2,)`` (compass interval, shifted by a multiple of 2 pi into about
+``[-pi, pi]``). Reward: the newly and truly sensed free area (m^2). ``info`` holds the
+:class:`~digslam.observer.record.MissionRecord` under ``"record"`` and the
+:class:`~digslam.envs.episode.GroundTruth` under ``"truth"``.
+
+Record convention (record ``j`` is the one returned at time ``t_j``; ``j = 0`` by ``reset``):
+
+* ``heading[j]`` bounds the true heading at ``t_j`` and ``range[j]`` the exact distances from the pose at
+  ``t_j``;
+* ``speed[j]`` and ``yaw_rate[j]`` bound the true values over the WHOLE step that just ended,
+  ``[t_{j-1}, t_j]`` (the hull over all its physics substeps, see :mod:`.robot`), not instantaneous values;
+  record 0 carries the robot at rest, ``[0, 0]`` widened by the noise bound.
+
+This is the data contract of :mod:`digslam.observer.record`, which the observers (offline ``dig_slam``,
+the online filter of :mod:`.observer_wrapper`) read as it is. Every bound is widened by
+:data:`~.sensors.SIM_TOL` for the simulator's own rounding.
 """
 
 from __future__ import annotations
@@ -24,7 +37,7 @@ from .coverage import Coverage
 from .episode import GroundTruth
 from .generators import GENERATORS, WorldGenerator
 from .robot import RobotSim
-from .sensors import SensorSuite, measure_step
+from .sensors import SIM_TOL, SensorSuite, measure_step
 from .world import World
 
 
@@ -166,7 +179,15 @@ class ExploreEnv(gym.Env):
         ranges = self.suite.true_ranges(self.world, pose)
         speed, yaw = self.sim.speed, self.sim.yaw_rate
         record = measure_step(
-            self.t, self.suite, ranges, speed, yaw, pose[2], self.config.noise, self.np_random
+            self.t,
+            self.suite,
+            ranges,
+            self.sim.speed_hull,
+            self.sim.yaw_hull,
+            pose[2],
+            self.config.noise,
+            self.np_random,
+            tol=SIM_TOL,
         )
         truth = GroundTruth(
             t=self.t,

@@ -1,10 +1,12 @@
 """Scripted missions with exact ground truth, for the offline observer (thesis §6.4.2).
 
 The robot follows a closed loop of waypoints with a pure-pursuit controller. Between two samples its
-speed ``v_k`` and yaw rate ``ω_k`` are constant, so the motion over ``[t_k, t_{k+1}]`` is an exact arc and
-its heading moves linearly from ``ψ_k`` to ``ψ_{k+1}``. This is the data contract the observer relies on:
+speed and yaw rate are constant over each slice, so the motion over ``[t_k, t_{k+1}]`` is an exact arc and
+its heading moves linearly from ``ψ_k`` to ``ψ_{k+1}``. The records follow the data contract of
+:mod:`digslam.observer.record`, like the environments':
 
-* ``speed[k]`` and ``yaw_rate[k]`` bound the true values over the whole slice ``[t_k, t_{k+1})``;
+* ``speed[k]`` and ``yaw_rate[k]`` bound the true values over the slice ``[t_{k-1}, t_k]`` that ends at
+  ``t_k`` (record 0: the robot at rest);
 * ``heading[k]`` bounds the true heading at ``t_k`` (a compass);
 * ``range[k]`` bounds the exact sonar / omnidirectional distances (:class:`~.sensors.SensorSuite`) at
   the true pose ``k``.
@@ -12,8 +14,8 @@ its heading moves linearly from ``ψ_k`` to ``ψ_{k+1}``. This is the data contr
 The truth is computed in float64: each arc is evaluated from the stored pose over the exact duration
 ``t_{k+1} - t_k`` of the recorded times, and its own rounding (a few ulps per step, never accumulated
 because every step restarts from the stored pose) is covered by widening every interval by
-:data:`SIM_TOL` (relative, at least absolute). Under ``adversarial`` noise the truth therefore lies within
-``SIM_TOL`` of a bound rather than exactly on it.
+:data:`~.sensors.SIM_TOL` (relative, at least absolute). Under ``adversarial`` noise the truth therefore
+lies within ``SIM_TOL`` of a bound rather than exactly on it.
 
 >>> rec, truth = loop_mission(duration=2.0, seed=0)
 >>> len(rec), truth.shape, bool(np.all(rec.range[:, 0, 0] <= rec.range[:, 0, 1]))
@@ -30,7 +32,7 @@ from digslam.observer.record import MissionRecord
 
 from .config import NoiseConfig
 from .generators import ThesisRoom
-from .sensors import SensorSuite, measure_step
+from .sensors import SIM_TOL, SensorSuite, measure_step
 from .world import World
 
 #: A loop of waypoints inside the thesis room of Fig. 6.10 (at least 1.3 m from every wall).
@@ -38,20 +40,6 @@ THESIS_LOOP = np.array(
     [(0.0, 0.0), (3.0, -5.5), (6.5, -5.0), (5.0, -1.0), (4.0, 2.5), (6.5, 5.5), (4.0, 6.5), (0.5, 2.0),
      (-3.0, 5.5), (-6.5, 5.5), (-5.5, 2.5), (-2.5, 0.5), (-6.5, -3.5), (-6.0, -6.5), (-2.0, -5.0)]
 )  # fmt: skip
-
-
-#: Relative (and absolute, below magnitude 1) widening that covers the generator's own float64 rounding.
-SIM_TOL = 1e-12
-
-
-def _pad(rec: MissionRecord) -> MissionRecord:
-    """Widen the interval fields by :data:`SIM_TOL`."""
-    d = rec.as_dict()
-    for name in ("speed", "yaw_rate", "heading", "range"):
-        v = d[name]
-        pad = SIM_TOL * np.maximum(1.0, np.abs(np.where(np.isfinite(v), v, 0.0)))
-        d[name] = np.stack([v[..., 0] - pad[..., 0], v[..., 1] + pad[..., 1]], axis=-1)
-    return MissionRecord(**d)
 
 
 def arc(pose: np.ndarray, v: float, w: float, dt: float) -> np.ndarray:
@@ -110,6 +98,7 @@ def loop_mission(
     d0 = wp[1] - wp[0]
     pose = np.array([wp[0, 0], wp[0, 1], math.atan2(d0[1], d0[0])])
     target, records, truth = 1, [], []
+    odo = (0.0, 0.0)  # record 0: at rest
     for k in range(n + 1):
         to = wp[target] - pose[:2]
         if np.hypot(*to) < 0.6:
@@ -119,10 +108,11 @@ def loop_mission(
         w = float(np.clip(1.5 * err, -max_yaw_rate, max_yaw_rate))
         v = speed * max(0.2, math.cos(err))
         ranges = suite.true_ranges(world, pose)
-        records.append(_pad(measure_step(k * dt, suite, ranges, v, w, float(pose[2]), noise, rng)))
+        records.append(measure_step(k * dt, suite, ranges, *odo, float(pose[2]), noise, rng, tol=SIM_TOL))
         truth.append([*pose, v, w])
         pose = arc(pose, v, w, (k + 1) * dt - k * dt)
+        odo = (v, w)  # bounded by the next record: the slice that ends there
     return MissionRecord.stack(records), np.array(truth)
 
 
-__all__ = ["SIM_TOL", "THESIS_LOOP", "arc", "loop_mission"]
+__all__ = ["THESIS_LOOP", "arc", "loop_mission"]

@@ -1,11 +1,18 @@
-"""Pymunk physics: static walls from the world's edges and a disc robot driven by a unicycle command.
+"""A disc robot with exact unicycle kinematics, blocked (never sliding) by the world's walls.
 
-The robot is a dynamic circle pulled by a kinematic control body through a pivot joint (drive) and a gear
-joint (steering), both with ``max_bias = 0`` and a finite force. The control body takes the commanded
-velocities; the robot follows only as far as the walls allow, so it never tunnels (setting the robot's
-velocity directly would). Pymunk detects contacts only once shapes overlap, by up to one substep's travel;
-the collision disc is therefore the robot's radius plus a ``skin`` of that travel, so the nominal disc never
-overlaps an obstacle. Bumps (new contacts with a wall) are counted.
+Motion model (the data contract of the guaranteed observer, see :mod:`.missions`): the robot follows exact
+arcs of constant ``(v_i, ω)``, so ``ẋ = v (cos ψ, sin ψ)`` holds at every instant with ``ψ`` linear. ``v_i``
+is the commanded speed up to the first substep whose sweep is blocked; the rest of the step runs, as one arc,
+at that speed scaled by the largest fraction in ``(1/2, 1/4, 1/8, 0)`` whose sweep is clear. A sweep is
+checked at the midpoints of ``m`` equal pieces of the arc with a margin of half a piece's travel (every
+point of the arc lies within that of a midpoint), so the nominal disc never overlaps an obstacle and never
+tunnels. Rotation in place is always allowed (the disc does not move). A bump is a step that gets blocked
+after an unblocked one.
+
+An earlier version drove the robot through pymunk joints: the body's velocity then lagged its heading (by up
+to 0.5 rad on reversals) and slid along walls, motions that no unicycle with the recorded heading explains,
+so the observer's tube could miss the truth. The pymunk space (walls, body, control body and joints) is
+still built and kept in sync, for reference ray casting (``benchmarks/bench_env.py``).
 """
 
 from __future__ import annotations
@@ -15,21 +22,50 @@ import math
 import numpy as np
 import pymunk
 
+from . import geometry as geo
 from .world import World
 
 ROBOT_TYPE, WALL_TYPE = 1, 2
+#: Fractions of the commanded speed tried, in order, when a substep's sweep is blocked.
+FRACTIONS = (1.0, 0.5, 0.25, 0.125)
+#: Sweep check points per substep.
+SWEEP_POINTS = 4
+
+
+def arcs(pose: np.ndarray, v: float | np.ndarray, w: float, tau: np.ndarray) -> np.ndarray:
+    """Exact unicycle poses ``(..., len(tau), 3)`` after ``tau`` s of constant ``(v, ω)`` from ``pose``
+    (``v`` a scalar or an array of speeds, broadcast against ``tau``)."""
+    x, y, th = (float(c) for c in pose)
+    v = np.asarray(v, dtype=np.float64)[..., None] if np.ndim(v) else float(v)
+    th2 = th + w * tau
+    if abs(w) < 1e-12:
+        px, py = x + v * tau * math.cos(th), y + v * tau * math.sin(th)
+    else:
+        k = v / w
+        px, py = x + k * (np.sin(th2) - math.sin(th)), y - k * (np.cos(th2) - math.cos(th))
+    th2 = np.broadcast_to(th2, np.shape(px))
+    return np.stack([px, py, th2], axis=-1)
+
+
+def arc(pose: np.ndarray, v: float, w: float, tau: float) -> np.ndarray:
+    """:func:`arcs` for one scalar ``tau`` (plain floats, same formulas)."""
+    x, y, th = (float(c) for c in pose)
+    th2 = th + w * tau
+    if abs(w) < 1e-12:
+        return np.array([x + v * tau * math.cos(th), y + v * tau * math.sin(th), th2])
+    k = v / w
+    return np.array([x + k * (math.sin(th2) - math.sin(th)), y - k * (math.cos(th2) - math.cos(th)), th2])
 
 
 class RobotSim:
-    """A pymunk space holding the world's walls and the robot.
+    """The robot's exact kinematics, plus a pymunk space holding the world's walls and the robot.
 
     Args:
         world: Ground-truth world; each edge becomes a static ``pymunk.Segment``.
         radius: Robot radius (m).
         pose: Start pose ``(x, y, theta)``.
-        max_force: Drive force limit (N).
-        max_torque: Steering torque limit (N m).
-        skin: Extra collision radius (m); at least the largest travel in one substep.
+        skin: Extra radius of the pymunk collision disc (reference loop only; the kinematics use ``radius``).
+        max_force, max_torque: Joint limits of the pymunk reference loop only.
     """
 
     def __init__(
@@ -67,36 +103,74 @@ class RobotSim:
         self.space.add(self.body, self.shape, self.control, pivot, gear)
         self.bumps = 0
         self.space.on_collision(ROBOT_TYPE, WALL_TYPE, begin=self._on_bump)
-        self._touching = 0
+        self.radius, self.edges, self.bbox = float(radius), world.edges, world.bbox
+        self._pose = np.array([float(pose[0]), float(pose[1]), float(pose[2])])
+        self._v, self._w, self._blocked = 0.0, 0.0, False
+        self.speed_hull: tuple[float, float] = (0.0, 0.0)
+        self.yaw_hull: tuple[float, float] = (0.0, 0.0)
 
     def _on_bump(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
-        self.bumps += 1
+        pass  # contacts of the reference pymunk loop (benchmarks) are not the robot's bumps
+
+    def _sweep_ok(self, pose: np.ndarray, vs: np.ndarray, w: float, tau: np.ndarray, piece: float,
+                  edges: np.ndarray) -> np.ndarray:  # fmt: skip
+        """``(len(vs), len(tau))``: whether the disc centred at the arc points ``tau`` (midpoints of pieces of
+        duration ``piece``) keeps ``radius`` plus half a piece's travel off every edge."""
+        mids = arcs(pose, vs, w, tau)
+        d = geo.point_edge_distance(mids[..., :2].reshape(-1, 2), edges).reshape(len(vs), len(tau))
+        return d >= self.radius + np.abs(vs)[:, None] * (0.5 * piece)
 
     def step(self, v: float, omega: float, dt: float, substeps: int) -> int:
-        """Advance ``dt`` seconds under command ``(v, omega)``; return the bumps that occurred."""
+        """Advance ``dt`` seconds under command ``(v, omega)``; return the bumps that occurred.
+
+        The substeps before the first blocked one run at full speed; the rest of the step runs at the
+        largest fraction of :data:`FRACTIONS` (or 0) whose sweep is clear, as one arc. Afterwards
+        :attr:`speed_hull` and :attr:`yaw_hull` hold the hull of the true speed and yaw rate over the
+        whole step.
+        """
         before = self.bumps
         h = dt / substeps
-        self.control.angular_velocity = omega
-        for _ in range(substeps):
-            a = self.body.angle
-            self.control.velocity = (v * math.cos(a), v * math.sin(a))
-            self.space.step(h)
+        m = SWEEP_POINTS
+        x, y = float(self._pose[0]), float(self._pose[1])
+        edges = geo.edges_near(self.edges, self.bbox, x, y, abs(v) * dt + self.radius + 1e-9)
+        first = substeps
+        if v != 0.0 and len(edges):
+            tau = (np.arange(substeps * m) + 0.5) * (h / m)
+            ok = self._sweep_ok(self._pose, np.array([v]), omega, tau, h / m, edges)[0]
+            if not ok.all():
+                first = int(np.argmin(ok)) // m
+        used = [v] * first
+        if first:
+            self._pose = arc(self._pose, v, omega, first * h)
+        rest = substeps - first
+        if rest:
+            vs = v * np.array(FRACTIONS[1:])
+            tau = (np.arange(rest * m) + 0.5) * (h / m)
+            ok = self._sweep_ok(self._pose, vs, omega, tau, h / m, edges).all(axis=1)
+            vi = float(vs[int(np.argmax(ok))]) if ok.any() else 0.0
+            self._pose = arc(self._pose, vi, omega, rest * h)
+            used += [vi] * rest
+            if not self._blocked:
+                self.bumps += 1
+        self._blocked = rest > 0
+        self._v, self._w = used[-1], float(omega)
+        self.speed_hull = (min(used), max(used))
+        self.yaw_hull = (float(omega), float(omega))
+        self.body.position = (float(self._pose[0]), float(self._pose[1]))
+        self.body.angle = float(self._pose[2])
         return self.bumps - before
 
     @property
     def pose(self) -> np.ndarray:
         """True pose ``(x, y, theta)`` with a continuous (unwrapped) heading."""
-        p = self.body.position
-        return np.array([p.x, p.y, self.body.angle])
+        return self._pose.copy()
 
     @property
     def speed(self) -> float:
         """True forward speed (velocity projected on the heading, m/s)."""
-        a = self.body.angle
-        vel = self.body.velocity
-        return vel.x * math.cos(a) + vel.y * math.sin(a)
+        return self._v
 
     @property
     def yaw_rate(self) -> float:
         """True yaw rate (rad/s)."""
-        return float(self.body.angular_velocity)
+        return self._w

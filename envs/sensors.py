@@ -2,6 +2,11 @@
 
 Range truth is geometric (:func:`geometry.sector_distance` over the edges pre-filtered by bounding boxes),
 never a ray fan. The omnidirectional sensor is a cone of half-aperture ``pi``.
+
+Odometry may be given as a hull ``(lo, hi)`` of the true values over a time slice (the env passes the hull
+over every physics substep of the step that just ended); the reported interval then contains the whole hull.
+``tol`` widens every finite bound by ``tol * max(1, |bound|)`` to cover the simulator's own float64 rounding
+(:data:`SIM_TOL`, the same widening as :data:`digslam.envs.missions.SIM_TOL`).
 """
 
 from __future__ import annotations
@@ -17,6 +22,22 @@ from . import geometry as geo
 from .config import ExploreConfig, NoiseConfig
 from .noise import measure, outliers
 from .world import World
+
+#: Relative (absolute below magnitude 1) widening of the env's records for the simulator's float rounding.
+SIM_TOL = 1e-12
+
+Hull = float | tuple[float, float]
+
+
+def _hull(v: Hull) -> tuple[float, float]:
+    if isinstance(v, tuple):
+        return float(v[0]), float(v[1])
+    return float(v), float(v)
+
+
+def _pad(v: np.ndarray, tol: float, up: bool) -> np.ndarray:
+    pad = tol * np.maximum(1.0, np.abs(np.where(np.isfinite(v), v, 0.0)))
+    return v + pad if up else v - pad
 
 
 @dataclass(frozen=True, eq=False)
@@ -73,16 +94,23 @@ def measure_step(
     t: float,
     suite: SensorSuite,
     ranges: np.ndarray,
-    speed: float,
-    yaw_rate: float,
+    speed: Hull,
+    yaw_rate: Hull,
     heading: float,
     noise: NoiseConfig,
     rng: np.random.Generator,
+    tol: float = 0.0,
 ) -> MissionRecord:
     """Noisy record of one step from the true values (``ranges`` from :meth:`SensorSuite.true_ranges`).
 
-    The random generator is advanced by the same amount whatever the values, so runs stay reproducible.
+    ``speed`` and ``yaw_rate`` are true values or hulls ``(lo, hi)`` of true values; the interval reported
+    for a hull is the noisy interval of its midpoint widened by its half-width, so it contains the whole hull
+    (under ``adversarial`` noise the hull touches a bound). The random generator is advanced by the same
+    amount whatever the values, so runs stay reproducible.
     """
+    (s_lo, s_hi), (w_lo, w_hi) = _hull(speed), _hull(yaw_rate)
+    half = np.array([0.5 * (s_hi - s_lo), 0.5 * (w_hi - w_lo)])
+    speed, yaw_rate = 0.5 * (s_lo + s_hi), 0.5 * (w_lo + w_hi)
     no_echo = ~np.isfinite(ranges)
     n = suite.n
     truth = np.empty(n + 3)
@@ -94,6 +122,10 @@ def measure_step(
     _, lo, hi = measure(truth, bounds, noise, rng)
     out = np.empty((n + 3, 2))  # rows: speed, yaw rate, heading, then the ranges
     out[:, 0], out[:, 1] = lo, hi
+    out[:2, 0] -= half
+    out[:2, 1] += half
+    out[:2, 0] = np.minimum(out[:2, 0], [s_lo, w_lo])  # exact containment despite the rounding of +-half
+    out[:2, 1] = np.maximum(out[:2, 1], [s_hi, w_hi])
     rng_out = out[3:]
     rng_out[:, 0] = np.where(no_echo, suite.r_max, np.maximum(lo[3:], 0.0))
     rng_out[no_echo, 1] = np.inf
@@ -102,6 +134,8 @@ def measure_step(
         rng_out[flag, 0], rng_out[flag, 1] = o_lo[flag], o_hi[flag]
     else:
         flag = np.zeros(n, dtype=bool)
+    if tol > 0:
+        out[:, 0], out[:, 1] = _pad(out[:, 0], tol, False), _pad(out[:, 1], tol, True)
     return MissionRecord(
         t=np.float64(t),
         speed=out[0],

@@ -14,9 +14,9 @@ all the gates, then contracts all the gates against the whole ``M⁻`` (a Jacobi
 least as strong as its sequential loop since ``M⁻`` only grows). An empty gate means the data contradict
 their bounds: the result then says so (``consistent`` is False) and carries no sets.
 
-Data contract (see :mod:`digslam.envs.missions`): ``speed[k]`` and ``yaw_rate[k]`` bound the true values
-over the whole slice ``[t_k, t_{k+1})``; ``heading[k]`` bounds the heading at ``t_k``; ``range[k]`` bounds
-the range from the pose at ``t_k``.
+Data contract (:mod:`.record`): ``speed[k]`` and ``yaw_rate[k]`` bound the true values over the whole
+slice ``[t_{k-1}, t_k]`` that ends at ``t_k``; ``heading[k]`` bounds the heading at ``t_k``; ``range[k]``
+bounds the ranges from the pose at ``t_k``.
 
 >>> from digslam.observer.record import MissionRecord
 >>> n = 11
@@ -186,11 +186,11 @@ def dig_slam(
         raise ValueError(f"x0_lo, x0_hi: expected a 2-d box, got {x0_lo} and {x0_hi}")
     t = record.t
     heading = heading_from_compass(t, record.heading[:, 0], record.heading[:, 1],
-                                   record.yaw_rate[:-1, 0], record.yaw_rate[:-1, 1])  # fmt: skip
+                                   record.yaw_rate[1:, 0], record.yaw_rate[1:, 1])  # fmt: skip
     if heading.is_empty():  # compass and gyro contradict each other
         at = heading.inconsistent_at if heading.inconsistent_at is not None else heading.first_empty()
         return DigSlamResult(False, at, None, None, heading, 0)
-    u_lo, u_hi = unicycle_velocity(record.speed[:-1, 0], record.speed[:-1, 1],
+    u_lo, u_hi = unicycle_velocity(record.speed[1:, 0], record.speed[1:, 1],
                                    heading.slice_lo[:, 0], heading.slice_hi[:, 0])  # fmt: skip
     n = t.shape[0]
     g_lo, g_hi = np.full((n, 2), -np.inf), np.full((n, 2), np.inf)

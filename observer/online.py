@@ -2,10 +2,10 @@
 
 Each :meth:`OnlineDigSlam.update` takes the next single-step record and
 
-1. predicts ``ψ_k ∈ [ψ_{k-1}] + [dt]·[ω_{k-1}]`` (intersected with the compass) and the heading over the
-   slice, then ``x_k ∈ x_{k-1} + [dt]·[v_{k-1}] (cos, sin)([ψ] on the slice)`` (Eq. 6.23; the previous
-   record's speed and yaw rate bound the truth over the slice: data contract of
-   :mod:`digslam.envs.missions`); scalar outward rounding, each correctly rounded operation is stepped one
+1. predicts ``ψ_k ∈ [ψ_{k-1}] + [dt]·[ω_k]`` (intersected with the compass) and the heading over the
+   slice, then ``x_k ∈ x_{k-1} + [dt]·[v_k] (cos, sin)([ψ] on the slice)`` (Eq. 6.23; record ``k``'s speed
+   and yaw rate bound the truth over the slice ``[t_{k-1}, t_k]`` that ends at it: the data contract of
+   :mod:`digslam.observer.record`); scalar outward rounding, each correctly rounded operation is stepped one
    ulp outward (``math.nextafter``), ``cos``/``sin`` widened by more than :data:`~.rounding.LIBM_ULPS`;
 2. contracts the box with the impacts ``dist(x_k, comp M⁻) <= y⁺`` (Eq. 6.22) on a window;
 3. digs ``M⁻ := M⁻ ∪ g⁻¹_{[x_k]}(Z⁻)`` (Eq. 6.21) and grows the explored zone: certainly sensed =
@@ -186,7 +186,7 @@ class OnlineDigSlam:
         dt = float(rec.t) - float(p.t)
         dtl, dth = _dn(dt), _up(dt)
         # heading (compass fused with the gyro, Eq. 6.12) and its slice
-        wl, wh = _mul(dtl, dth, float(p.yaw_rate[0]), float(p.yaw_rate[1]))
+        wl, wh = _mul(dtl, dth, float(rec.yaw_rate[0]), float(rec.yaw_rate[1]))
         h0l, h0h = self.heading_lo, self.heading_hi
         hl, hh = max(float(rec.heading[0]), _dn(h0l + wl)), min(float(rec.heading[1]), _up(h0h + wh))
         zl, zh = min(wl, 0.0), max(wh, 0.0)
@@ -195,7 +195,7 @@ class OnlineDigSlam:
             return self._fail(start)
         # position (Eq. 6.23): x_k = x_{k-1} + [dt]·[v]·(cos, sin)[ψ]
         cl, ch, snl, snh = _cos_sin(sl, sh)
-        vl, vh = float(p.speed[0]), float(p.speed[1])
+        vl, vh = float(rec.speed[0]), float(rec.speed[1])
         d = [_mul(dtl, dth, *_mul(vl, vh, cl, ch)), _mul(dtl, dth, *_mul(vl, vh, snl, snh))]
         lo = np.array([_dn(float(self.pose_lo[i]) + d[i][0]) for i in (0, 1)])
         hi = np.array([_up(float(self.pose_hi[i]) + d[i][1]) for i in (0, 1)])

@@ -10,6 +10,11 @@ half-aperture ``gamma`` in ``(0, pi]`` (``gamma = pi`` is the omnidirectional se
 echoing cone's interval contains the distance from the robot centre to the nearest obstacle point anywhere in
 its sector.
 
+Data contract (what the observers rely on): ``heading[k]`` bounds the true heading at ``t_k`` and
+``range[k]`` the exact distances from the pose at ``t_k``; ``speed[k]`` and ``yaw_rate[k]`` bound the true
+speed and yaw rate over the WHOLE slice ``[t_{k-1}, t_k]`` that ends at ``t_k`` (odometry integrated over
+the step just ended, not an instantaneous value); record 0's odometry bounds nothing the observers use.
+
 This module needs numpy only, so the observer can read missions without importing the simulator.
 
 >>> rec = MissionRecord(t=0.0, speed=[0.9, 1.1], yaw_rate=[-0.01, 0.01], heading=[0.0, 0.002],

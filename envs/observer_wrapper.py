@@ -1,0 +1,244 @@
+"""``GuaranteedObserver``: the online Dig-SLAM filter (thesis §6.4, Algorithm 6.3) wrapped around the raw env.
+
+At every step the filter (:class:`~digslam.observer.online.OnlineDigSlam`) turns the bounded record into the
+pose box, the dig zone ``M⁻`` and the explored thick set, and the wrapper hands them to the agent:
+
+* ``"map"``: ``uint8 (C, m, m)`` channels-first image (SB3 image convention, values 0 / 255): clear,
+  penumbra, dark (conservative downsampling, :mod:`.observer_maps`), the pose-box footprint, and with
+  ``crop`` three more channels clear / penumbra / dark of a ``crop`` x ``crop`` m window centred on the pose
+  box (world-aligned; outside the grid counts as dark);
+* ``"state"``: ``float32 (11,)``: the pose box ``(x⁻, y⁻, x⁺, y⁺)`` normalised to ``[-1, 1]`` over the grid
+  frame, ``cos``/``sin`` of the mid heading and the heading half-width over ``π``, ``tanh`` of the tube width
+  (m), the elapsed share of ``horizon``, the certified coverage and the consistency flag.
+
+``info`` adds the sets as arrays (``explored`` int8 CLEAR/PENUMBRA/DARK, ``dig`` and ``clear`` bool, all
+``(ny, nx)`` with row 0 at the top; ``pose_box (2, 2)``, ``heading_box (2,)``), ``certified_coverage``
+(clear cells in the reachable free area over that area, :func:`reachable_free`), ``clear_area`` (m²),
+``true_coverage`` (the raw env's ground-truth share) and ``consistent`` / ``inconsistent_step``.
+If the filter finds the data inconsistent (e.g. an outlier) it stops, every claim is withdrawn (the map
+becomes all penumbra) and the episode is truncated: never a false claim.
+
+Records go to the filter as they come: record ``k``'s odometry bounds the step that ends at ``t_k``, the
+data contract of :mod:`digslam.observer.record` that both the env and the filter follow.
+
+>>> from digslam.envs.explore_env import ExploreEnv
+>>> env = GuaranteedObserver(ExploreEnv(), map_size=36)
+>>> obs, info = env.reset(seed=0)
+>>> obs["map"].shape, obs["map"].dtype.name, obs["state"].shape, info["consistent"]
+((4, 36, 36), 'uint8', (11,), True)
+>>> bool(info["pose_box"][0, 0] <= info["truth"].pose[0] <= info["pose_box"][1, 0])
+True
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from scipy import ndimage
+
+from digslam.observer.grid import Grid
+from digslam.observer.online import OnlineConfig, OnlineDigSlam
+from digslam.observer.record import MissionRecord
+from digslam.observer.thick_sep import DARK, PENUMBRA
+
+from .monitor import GuaranteeMonitor
+from .observer_config import ObserverConfig
+from .observer_maps import crop_window, pixel_range, three_state
+from .raster import FREE, rasterize
+from .world import World
+
+N_STATE = 11
+
+
+def make_grid(cfg: ObserverConfig, world_frame: tuple[float, ...]) -> Grid:
+    """The observer grid over ``cfg.grid_frame`` (default: the world frame); it must cover the world."""
+    f = cfg.grid_frame or tuple(float(v) for v in world_frame)
+    w = world_frame
+    if not (f[0] <= w[0] and f[1] <= w[1] and f[2] >= w[2] and f[3] >= w[3]):
+        raise ValueError(f"grid_frame: {f} does not cover the world frame {tuple(w)}")
+    n = max(int(math.ceil((f[2] - f[0]) / cfg.grid_cell - 1e-9)), 1)
+    return Grid((f[0], f[1]), (f[2], f[3]), (n, n))
+
+
+def reachable_free(world: World, grid: Grid, start: np.ndarray) -> np.ndarray:
+    """``(ny, nx)`` bool: cells entirely free in the exact raster, 8-connected to the start's cell."""
+    x0, y0, x1, _ = grid.lo + grid.hi
+    res = (x1 - x0) / grid.shape[1]
+    free = rasterize(world.edges, (x0, y0, grid.hi[0], grid.hi[1]), res)[::-1] == FREE  # row 0 at the top
+    free = free[: grid.shape[0], : grid.shape[1]]
+    labels, _ = ndimage.label(free, structure=np.ones((3, 3), dtype=bool))
+    col = int(Grid.count_below(grid.xs, np.array([start[0]]))[0]) - 1
+    row = int(Grid.count_below(-grid.ys, np.array([-start[1]]))[0]) - 1
+    lab = labels[min(max(row, 0), grid.shape[0] - 1), min(max(col, 0), grid.shape[1] - 1)]
+    return labels == lab if lab else np.zeros(grid.shape, dtype=bool)
+
+
+class GuaranteedObserver(gym.Wrapper):
+    """The online guaranteed observer as a ``gymnasium`` wrapper (see the module docstring).
+
+    Args:
+        env: an :class:`~digslam.envs.explore_env.ExploreEnv` (possibly wrapped).
+        grid_cell, map_size, crop, monitor: override the fields of ``config``.
+        config: an :class:`ObserverConfig`, a mapping, or an ``OnlineConfig`` (filter settings only).
+    """
+
+    def __init__(
+        self,
+        env: gym.Env,
+        grid_cell: float | None = None,
+        map_size: int | None = None,
+        crop: float | None = None,
+        monitor: bool | None = None,
+        config: ObserverConfig | OnlineConfig | Mapping[str, Any] | None = None,
+    ) -> None:
+        super().__init__(env)
+        if isinstance(config, OnlineConfig):
+            config = ObserverConfig(online=config)
+        cfg = config if isinstance(config, ObserverConfig) else ObserverConfig.from_dict(config or {})
+        over = {"grid_cell": grid_cell, "map_size": map_size, "crop": crop, "monitor": monitor}
+        cfg = cfg.replace(**{k: v for k, v in over.items() if v is not None})
+        self.obs_config = cfg
+        raw = env.unwrapped
+        self.grid = make_grid(cfg, raw.generator.frame)
+        m = cfg.map_size
+        self.n_channels = 4 + (3 if cfg.crop is not None else 0)
+        self.observation_space = spaces.Dict(
+            {
+                "map": spaces.Box(0, 255, shape=(self.n_channels, m, m), dtype=np.uint8),
+                "state": spaces.Box(-1.0, 1.0, shape=(N_STATE,), dtype=np.float32),
+            }
+        )
+        self.filter = OnlineDigSlam(self.grid, cfg.online)
+        g = self.grid
+        self.cell_area = g.cell_size[0] * g.cell_size[1]
+        self._centre = 0.5 * (np.array(g.lo) + np.array(g.hi))
+        self._half = 0.5 * (np.array(g.hi) - np.array(g.lo))
+        self._reach_world: Any = None
+        self.reachable = np.zeros(g.shape, dtype=bool)
+        self.monitor: GuaranteeMonitor | None = None
+        self.steps, self._cache_step = 0, -1
+        self._cache: tuple[np.ndarray, np.ndarray] = (np.zeros(0), np.zeros(0))
+
+    # --- gymnasium API -------------------------------------------------------------------------------------
+    def reset(self, **kwargs: Any) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        _, info = self.env.reset(**kwargs)
+        raw = self.env.unwrapped
+        truth = info["truth"]
+        self.grid_check(raw.world)
+        if self._reach_world is not raw.world or not self._in_reach(truth.pose):  # once per world and start
+            self.reachable = reachable_free(raw.world, self.grid, truth.pose)
+            self.n_reachable = max(int(np.count_nonzero(self.reachable)), 1)
+            self._reach_world = raw.world
+        b = self.obs_config.start_box
+        p = truth.pose[:2]
+        lo = np.maximum(p - b, np.array(self.grid.lo))
+        hi = np.minimum(p + b, np.array(self.grid.hi))
+        self.filter.reset(lo, hi, info["record"])
+        self.steps, self._cache_step = 0, -1
+        self.monitor = GuaranteeMonitor(raw.world, self.grid) if self.obs_config.monitor else None
+        self._check(info)
+        self._clear_count = self._certified_count()
+        return self.observation(), self._obs_info(info)
+
+    def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        _, reward, terminated, truncated, info = self.env.step(action)
+        self._feed(info["record"])
+        self._check(info)
+        truncated = truncated or not self.filter.consistent
+        return self.observation(), float(reward), terminated, truncated, self._obs_info(info)
+
+    # --- pieces ---------------------------------------------------------------------------------------------
+    def _in_reach(self, pose: np.ndarray) -> bool:
+        g = self.grid
+        c = int(Grid.count_below(g.xs, np.array([pose[0]]))[0]) - 1
+        r = int(Grid.count_below(-g.ys, np.array([-pose[1]]))[0]) - 1
+        return 0 <= r < g.shape[0] and 0 <= c < g.shape[1] and bool(self.reachable[r, c])
+
+    def grid_check(self, world: World) -> None:
+        """Raise ``ValueError`` if the grid does not cover ``world``'s frame."""
+        make_grid(self.obs_config.replace(grid_frame=self.grid.lo + self.grid.hi), world.frame)
+
+    def _feed(self, rec: MissionRecord) -> None:
+        """Fold the env's record into the filter."""
+        self.filter.update(rec)
+        self.steps += 1
+
+    def _check(self, info: dict[str, Any]) -> None:
+        if self.monitor is not None:
+            self.monitor.check(self.filter, info["truth"], info["record"], self.steps)
+
+    def _sets(self) -> tuple[np.ndarray, np.ndarray]:
+        """The filter's explored codes and clear mask, computed once per step."""
+        if self._cache_step != self.steps:
+            self._cache = (self.filter.explored(), self.filter.clear_mask())
+            self._cache_step = self.steps
+        return self._cache
+
+    def _certified_count(self) -> int:
+        if not self.filter.consistent:
+            return 0
+        return int(np.count_nonzero(self._sets()[1] & self.reachable))
+
+    def observation(self) -> dict[str, np.ndarray]:
+        """The ``"map"`` and ``"state"`` of the filter's current sets (serves reset and step)."""
+        f, m, g = self.filter, self.obs_config.map_size, self.grid
+        img = np.zeros((self.n_channels, m, m), dtype=np.uint8)
+        state = np.zeros(N_STATE, dtype=np.float32)
+        if not f.consistent:  # claims withdrawn: everything is penumbra
+            img[1] = 255
+            return {"map": img, "state": state}
+        explored, clear = self._sets()
+        dark = explored == DARK
+        for ch, mask in enumerate(three_state(clear, dark, m)):
+            img[ch][mask] = 255
+        lo, hi = f.pose_lo, f.pose_hi
+        (r0,), (r1,), (c0,), (c1,) = g.window(lo[None], hi[None])
+        p0, p1 = pixel_range(int(r0), int(r1), g.shape[0], m)
+        q0, q1 = pixel_range(int(c0), int(c1), g.shape[1], m)
+        img[3, p0:p1, q0:q1] = 255
+        crop = self.obs_config.crop
+        if crop is not None:
+            k = max(int(math.ceil(crop / g.cell_size[0])), 1)
+            ctr = 0.5 * (lo + hi)
+            rc = int(Grid.count_below(-g.ys, np.array([-ctr[1]]))[0]) - 1
+            cc = int(Grid.count_below(g.xs, np.array([ctr[0]]))[0]) - 1
+            a, b = rc - k // 2, cc - k // 2
+            cw, dw = crop_window(clear, a, b, k, False), crop_window(dark, a, b, k, True)
+            for ch, mask in enumerate(three_state(cw, dw, m)):
+                img[4 + ch][mask] = 255
+        box = np.clip((np.concatenate([lo, hi]) - np.tile(self._centre, 2)) / np.tile(self._half, 2), -1, 1)
+        hm, hw = 0.5 * (f.heading_lo + f.heading_hi), 0.5 * (f.heading_hi - f.heading_lo)
+        state[:4] = box
+        state[4:7] = math.cos(hm), math.sin(hm), min(hw / math.pi, 1.0)
+        state[7] = math.tanh(float(np.max(hi - lo)))
+        state[8] = min(self.steps / self.obs_config.horizon, 1.0)
+        state[9] = self._certified_count() / self.n_reachable
+        state[10] = 1.0
+        return {"map": img, "state": state}
+
+    def _obs_info(self, info: dict[str, Any]) -> dict[str, Any]:
+        f = self.filter
+        out = dict(info)
+        ok = bool(f.consistent)
+        explored, clear = (
+            self._sets() if ok else (np.full(self.grid.shape, PENUMBRA), np.zeros(self.grid.shape, bool))
+        )
+        n = int(np.count_nonzero(clear & self.reachable))
+        out.update(
+            explored=explored,
+            dig=f.dig.free.copy() if ok else np.zeros(self.grid.shape, dtype=bool),
+            clear=clear,
+            pose_box=np.stack([f.pose_lo, f.pose_hi]) if ok else np.full((2, 2), np.nan),
+            heading_box=np.array([f.heading_lo, f.heading_hi]) if ok else np.full(2, np.nan),
+            certified_coverage=n / self.n_reachable,
+            clear_area=n * self.cell_area,
+            true_coverage=float(info.get("coverage", 0.0)),
+            consistent=ok,
+            inconsistent_step=f.inconsistent_step,
+        )
+        return out
