@@ -60,6 +60,8 @@ from .sep_image import CtcImage, SepImage
 from .sep_inverse import SepInverse
 from .sep_polygon import CtcPolygonBoundary, CtcSegments, SepPolygon
 from .separators import Sep, SepBox, SepInter, SepNot, SepQInter, SepUnion
+from .shape_registration import SepTranslationInclusion, ThickImage, level_thick_image, register_translation
+from .shape_slam import ShapeSlamConfig, ShapeSlamResult, ctc_minus, overlap_pretest, shape_slam
 from .shapes import free_zone, impact_zone, measurement_shapes
 from .subpaving import SepSubpaving, load, save, simplify
 from .thick_carving import (
@@ -121,6 +123,8 @@ __all__ = [
     "SRACResult", "ctc_image_equal", "ctc_image_param", "ctc_param_equal", "ctc_param_meets",
     "ctc_param_subset", "param_hull", "srac", "thick_image", "thick_image_param", "thick_minkowski_sum",
     "thick_product", "OnlineConfig", "OnlineDigSlam",
+    "SepTranslationInclusion", "ThickImage", "level_thick_image", "register_translation", "ShapeSlamConfig",
+    "ShapeSlamResult", "ctc_minus", "overlap_pretest", "shape_slam",
     "CLEAR", "DARK", "PENUMBRA", "UNKNOWN", "ThickSep", "thick_classify_grid", "thick_relaxed_intersection",
     "ctc_equal", "ctc_subset", "ThickFunction", "ThickIntervalArray", "thin",
     "SepSubpaving", "load", "save", "simplify",
