@@ -123,7 +123,11 @@ class RockField(WorldGenerator):
 
 
 class Caves(WorldGenerator):
-    """Caves: a smoothed noise field thresholded at the ``fill`` quantile and traced by marching squares."""
+    """Caves: a smoothed noise field thresholded at the ``fill`` quantile and traced by marching squares.
+
+    The start area is carved free and, if it would be a closed pocket, joined to the largest cave by a
+    straight corridor.
+    """
 
     name = "caves"
 
@@ -144,7 +148,35 @@ class Caves(WorldGenerator):
         f = f - 3.0 * np.clip(1.5 - r / max(self.keep_clear, 1e-9), 0.0, None)  # carve the start area
         level = float(np.quantile(f, self.fill))
         f[[0, -1], :] = f[:, [0, -1]] = level + 1.0  # closed outer wall
+        f = self._connect_start(f, level, xs)
         return World.from_edges(self.frame, marching_squares(f, level, self.frame), self.name)
+
+    def _connect_start(self, f: np.ndarray, level: float, xs: np.ndarray) -> np.ndarray:
+        """Carve a corridor from the start area to the largest cave, so that the start is not in a pocket."""
+        from scipy import ndimage
+
+        labels, n = ndimage.label(f <= level)
+        c = len(xs) // 2
+        if n <= 1 or labels[c, c] == 0:
+            return f
+        sizes = np.bincount(labels.ravel())
+        sizes[0] = 0
+        big = int(np.argmax(sizes))
+        if labels[c, c] == big:
+            return f
+        ii, jj = np.nonzero(labels == big)
+        k = int(np.argmin((ii - c) ** 2 + (jj - c) ** 2))
+        ti, tj = ii[k], jj[k]
+        steps = int(max(abs(ti - c), abs(tj - c))) + 1
+        half = max(1, int(np.ceil(self.keep_clear / (xs[1] - xs[0]))))  # corridor half-width in nodes
+        out = f.copy()
+        for a in np.linspace(0.0, 1.0, 2 * steps):
+            i, j = int(round(c + a * (ti - c))), int(round(c + a * (tj - c)))
+            out[max(i - half, 1) : i + half + 1, max(j - half, 1) : j + half + 1] = np.minimum(
+                out[max(i - half, 1) : i + half + 1, max(j - half, 1) : j + half + 1], level - 1.0
+            )
+        out[[0, -1], :] = out[:, [0, -1]] = level + 1.0
+        return out
 
 
 class RoomsCorridors(WorldGenerator):

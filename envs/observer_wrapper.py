@@ -65,17 +65,30 @@ def make_grid(cfg: ObserverConfig, world_frame: tuple[float, ...]) -> Grid:
     return Grid((f[0], f[1]), (f[2], f[3]), (n, n))
 
 
-def reachable_free(world: World, grid: Grid, start: np.ndarray) -> np.ndarray:
-    """``(ny, nx)`` bool: cells entirely free in the exact raster, 8-connected to the start's cell."""
+def reachable_free(world: World, grid: Grid, start: np.ndarray, sub: int = 4) -> np.ndarray:
+    """``(ny, nx)`` bool: cells entirely free in the exact raster and connected to the start.
+
+    Connectivity is taken on a raster ``sub`` times finer (8-connected free fine cells), so passages
+    narrower than an observer cell still connect the free space beyond them; a grid cell counts when it is
+    entirely free and its fine cells belong to the start's component.
+    """
     x0, y0, x1, _ = grid.lo + grid.hi
-    res = (x1 - x0) / grid.shape[1]
-    free = rasterize(world.edges, (x0, y0, grid.hi[0], grid.hi[1]), res)[::-1] == FREE  # row 0 at the top
-    free = free[: grid.shape[0], : grid.shape[1]]
-    labels, _ = ndimage.label(free, structure=np.ones((3, 3), dtype=bool))
+    ny, nx = grid.shape
+    res = (x1 - x0) / nx
+    frame = (x0, y0, grid.hi[0], grid.hi[1])
+    fine = rasterize(world.edges, frame, res / sub)[::-1] == FREE  # row 0 at the top
+    fine = fine[: ny * sub, : nx * sub]
+    labels, _ = ndimage.label(fine, structure=np.ones((3, 3), dtype=bool))
     col = int(Grid.count_below(grid.xs, np.array([start[0]]))[0]) - 1
     row = int(Grid.count_below(-grid.ys, np.array([-start[1]]))[0]) - 1
-    lab = labels[min(max(row, 0), grid.shape[0] - 1), min(max(col, 0), grid.shape[1] - 1)]
-    return labels == lab if lab else np.zeros(grid.shape, dtype=bool)
+    r, c = min(max(row, 0), ny - 1) * sub, min(max(col, 0), nx - 1) * sub
+    block = labels[r : r + sub, c : c + sub]
+    lab = int(block.max())  # the start cell's component (its free fine cells are connected)
+    if not lab:
+        return np.zeros(grid.shape, dtype=bool)
+    coarse = rasterize(world.edges, frame, res)[::-1][:ny, :nx] == FREE
+    inside = (labels == lab).reshape(ny, sub, nx, sub).all(axis=(1, 3))
+    return coarse & inside
 
 
 class GuaranteedObserver(gym.Wrapper):
