@@ -1,14 +1,14 @@
 """Distributed evaluation on Ray against the sequential one (issue 11).
 
 Evaluates ``--episodes`` episodes (maps ``seed, seed + 1, ...``) of the frontier agent, ``--steps`` steps
-each, twice in one run: sequentially with :func:`digslam.agents.evaluate.evaluate`, then with
+each (``--target 1.0`` by default, so no episode ends early), twice in one run: sequentially with :func:`digslam.agents.evaluate.evaluate`, then with
 :func:`digslam.agents.ray_eval.evaluate_ray` on a local Ray instance with ``--workers`` CPUs (one task per
 episode). The Ray time counts everything: starting the instance, the workers' imports, the episodes and
 the shutdown; the time without the start-up is printed too. Both results must be identical.
 
 Last line: ``speedup=<sequential time / Ray time>`` (goal >= 1.6 with 2 workers on 2 cores).
 
-    python benchmarks/bench_sweep.py [--episodes 16] [--steps 1000] [--workers 2]
+    python benchmarks/bench_sweep.py [--episodes 16] [--steps 2000] [--workers 2] [--target 1.0]
 """
 
 from __future__ import annotations
@@ -39,16 +39,19 @@ def same(a: object, b: object) -> bool:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--episodes", type=int, default=16, help="episodes (maps) of the frontier agent")
-    ap.add_argument("--steps", type=int, default=1000, help="steps per episode")
+    ap.add_argument("--steps", type=int, default=2000, help="steps per episode")
     ap.add_argument("--workers", type=int, default=2, help="CPUs of the local Ray instance")
     ap.add_argument("--seed", type=int, default=1000, help="first map seed")
+    ap.add_argument("--target", type=float, default=1.0,
+                    help="coverage share that ends an episode (1.0: every episode runs all its steps)")  # fmt: skip
     args = ap.parse_args()
+    kw = {"target": args.target}
 
     import ray
 
     t0 = time.perf_counter()
-    seq = evaluate({"frontier": build_policy("frontier", ENV)}, ENV, n_maps=args.episodes, seed=args.seed,
-                   steps=args.steps)  # fmt: skip
+    seq = evaluate({"frontier": build_policy("frontier", ENV, kw)}, ENV, n_maps=args.episodes, seed=args.seed,
+                   steps=args.steps, env_kwargs=kw)  # fmt: skip
     t_seq = time.perf_counter() - t0
     steps = int(seq.lengths["frontier"].sum())
     print(f"sequential: {args.episodes} episodes, {steps} steps in {t_seq:.1f} s ({1e3 * t_seq / steps:.2f} ms/step)")
@@ -57,7 +60,8 @@ def main() -> None:
     start_ray(None, args.workers)  # evaluate_ray attaches to it; timed separately
     t_init = time.perf_counter() - t0
     try:
-        dist = evaluate_ray(["frontier"], ENV, n_maps=args.episodes, seed=args.seed, steps=args.steps)
+        dist = evaluate_ray(["frontier"], ENV, n_maps=args.episodes, seed=args.seed, steps=args.steps,
+                            env_kwargs=kw)
         t_run = time.perf_counter() - t0 - t_init
     finally:
         t1 = time.perf_counter()
