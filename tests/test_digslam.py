@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from ground_truth import assert_free
 
 from digslam.envs.config import NoiseConfig
 from digslam.envs.generators import ThesisRoom
@@ -35,18 +36,6 @@ def slice_points(truth: np.ndarray, dt: float, n: int = 4) -> tuple[np.ndarray, 
     return np.concatenate(ts), np.concatenate(xs)
 
 
-def assert_dig_zone_free(free: np.ndarray, world: object, rng: np.random.Generator) -> None:
-    """No M⁻ cell meets an obstacle: exact raster, plus sampled points and corners of the cells."""
-    raster = np.flipud(world.raster(CELL))  # type: ignore[attr-defined]
-    assert raster.shape == free.shape
-    assert not np.any(free & (raster != 0)), "a dug cell is occupied or crossed by an edge"
-    rows, cols = np.nonzero(free)
-    pick = rng.choice(rows.size, min(rows.size, 3000), replace=False)
-    lo, hi = GRID.cell_boxes(rows[pick], cols[pick])
-    pts = np.concatenate([lo, hi, np.c_[lo[:, 0], hi[:, 1]], lo + (hi - lo) * rng.random(lo.shape)])
-    assert np.all(world.clearance(pts) > 0), "a point of a dug cell is not free"  # type: ignore[attr-defined]
-
-
 @pytest.mark.parametrize(
     ("suite", "model", "seed", "jitter"),
     [(OMNI, "uniform", 0, 0.0), (OMNI, "adversarial", 1, 0.3), (BOTH, "uniform", 2, 0.2),
@@ -65,7 +54,7 @@ def test_guarantees_against_ground_truth(suite, model, seed, jitter):
     ts, xs = slice_points(truth, 0.1)
     assert np.all(tube.contains(ts, xs)), "truth left a slice"
     assert np.all((tube.slice_lo <= xs[: len(truth) - 1]) & (xs[: len(truth) - 1] <= tube.slice_hi))
-    assert_dig_zone_free(res.dig.free, world, np.random.default_rng(seed))
+    assert_free(res.dig.free, world, GRID, np.random.default_rng(seed))
     assert res.dig.free.sum() * CELL**2 > 10.0  # it dug a real area
     assert_explored_sound(res.explored, rec, truth, suite, np.random.default_rng(seed))
 

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from ground_truth import assert_free
 
 from digslam.envs.config import NoiseConfig
 from digslam.envs.generators import ThesisRoom
@@ -44,18 +45,6 @@ def run(rec: MissionRecord, x0: np.ndarray, config: OnlineConfig | None = None, 
     return f, np.array(lo), np.array(hi)
 
 
-def assert_free(mask: np.ndarray, world: object, rng: np.random.Generator) -> None:
-    """No cell of ``mask`` meets an obstacle: exact raster, plus sampled points and corners of the cells."""
-    raster = np.flipud(world.raster(CELL))  # type: ignore[attr-defined]
-    assert raster.shape == mask.shape
-    assert not np.any(mask & (raster != 0)), "a claimed-free cell is occupied or crossed by an edge"
-    rows, cols = np.nonzero(mask)
-    pick = rng.choice(rows.size, min(rows.size, 2000), replace=False)
-    lo, hi = GRID.cell_boxes(rows[pick], cols[pick])
-    pts = np.concatenate([lo, hi, np.c_[lo[:, 0], hi[:, 1]], lo + (hi - lo) * rng.random(lo.shape)])
-    assert np.all(world.clearance(pts) > 0), "a point of a claimed-free cell is not free"  # type: ignore[attr-defined]
-
-
 def sensed_points(world: object, suite: SensorSuite, truth: np.ndarray, rng: np.random.Generator,
                   per: int = 12, every: int = 5) -> np.ndarray:  # fmt: skip
     """Points truly sensed: within the true range (``r_max`` when no echo) in each true cone."""
@@ -86,8 +75,8 @@ def test_guarantees_against_ground_truth(suite, model, seed, jitter, window, pad
     rec, truth = loop_mission(world, suite=suite, duration=30.0, noise=NoiseConfig(model=model), seed=seed)
     f, _, _ = run(rec, truth[0, :2], OnlineConfig(smoothing_window=window), truth, pad)
     rng = np.random.default_rng(seed)
-    assert_free(f.dig.free, world, rng)
-    assert_free(f.clear_mask(), world, rng)
+    assert_free(f.dig.free, world, GRID, rng, 2000)
+    assert_free(f.clear_mask(), world, GRID, rng, 2000)
     assert f.dig.free.sum() * CELL**2 > 10.0  # it dug a real area
     # every truly sensed point is in a possibly-sensed (non-dark) cell
     row, col = cell_of(sensed_points(world, suite, truth, rng))
