@@ -2,13 +2,15 @@
 
 A cell counts once its centre has lain inside some sensor's sector closer than the true range (or ``r_max``
 without echo): such points are certainly free. Only cells that are entirely free (exact raster) count, so
-the covered area never includes obstacle area.
+the covered area never includes obstacle area. Each update is one compiled pass over the cells within reach
+(:func:`.coverage_jit.cover_kernel`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from .coverage_jit import cover_kernel
 from .raster import FREE
 from .sensors import SensorSuite
 from .world import World
@@ -28,6 +30,7 @@ class Coverage:
         self.x0, self.y0 = world.frame[0], world.frame[1]
         self.free = world.raster(self.res) == FREE
         self.seen = np.zeros_like(self.free)
+        self.n_seen = 0  # count of seen cells, kept by update() (the only writer of seen)
         self.total_free = int(np.count_nonzero(self.free))
         self.k = int(np.ceil(reach / self.res)) + 1
         ny, nx = self.free.shape
@@ -53,7 +56,7 @@ class Coverage:
     @property
     def fraction(self) -> float:
         """Covered share of the free cells."""
-        return float(np.count_nonzero(self.seen)) / max(self.total_free, 1)
+        return float(self.n_seen) / max(self.total_free, 1)
 
     def update(self, pose: np.ndarray, suite: SensorSuite, ranges: np.ndarray) -> float:
         """Mark the cells sensed from ``pose`` and return the newly covered area (m^2)."""
@@ -61,21 +64,9 @@ class Coverage:
         ny, nx = self.free.shape
         ic, jc, k = int((y - self.y0) // self.res), int((x - self.x0) // self.res), self.k
         i0, i1, j0, j1 = max(ic - k, 0), min(ic + k + 1, ny), max(jc - k, 0), min(jc + k + 1, nx)
-        ii, jj = np.nonzero(self.free[i0:i1, j0:j1] & ~self.seen[i0:i1, j0:j1])
-        if len(ii) == 0:
-            return 0.0
-        reach = np.where(np.isfinite(ranges), np.minimum(ranges, suite.r_max), suite.r_max)
-        vx = self.xs[j0 + jj] - x
-        vy = self.ys[i0 + ii] - y
-        # Sensed radius as a step function of the bearing (one pass over the cells instead of one per sensor):
-        # on each angular interval between cone edges, the largest reach of the cones covering it. The
-        # interval bounds are turned into world bearings in [-pi, pi) and sorted; bearings before the first
-        # bound fall, through index -1, in the last interval, which wraps around.
         breaks, cover = self._angular_cover(suite)
-        radius = np.max(np.where(cover, reach[None, :], 0.0), axis=1)
-        world = np.mod(breaks + th + np.pi, 2 * np.pi) - np.pi
-        order = np.argsort(world, kind="stable")
-        k = np.searchsorted(world[order], np.arctan2(vy, vx), side="right") - 1
-        hit = vx * vx + vy * vy < radius[order][k] ** 2
-        self.seen[i0 + ii[hit], j0 + jj[hit]] = True
-        return float(np.count_nonzero(hit)) * self.cell_area
+        rng = np.ascontiguousarray(ranges, dtype=np.float64)
+        hits = cover_kernel(self.free, self.seen, self.xs, self.ys, i0, i1, j0, j1, x, y, th, breaks, cover,
+                            rng, suite._k_r_max)  # fmt: skip
+        self.n_seen += hits
+        return float(hits) * self.cell_area

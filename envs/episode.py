@@ -43,6 +43,18 @@ class GroundTruth:
         d["bumps"] = np.asarray(d["bumps"], dtype=np.int64)
         d["bumps_total"] = np.asarray(d["bumps_total"], dtype=np.int64)
 
+    @classmethod
+    def of_step(cls, t: float, pose: np.ndarray, speed: float, yaw_rate: float, ranges: np.ndarray,
+                bumps: int, bumps_total: int) -> GroundTruth:  # fmt: skip
+        """The same object as ``GroundTruth(...)`` for a float64 ``pose (3,)`` and ``ranges (n,)`` the caller
+        hands over, with the scalars as 0-d views of two small arrays: the env's per-step constructor."""
+        f = np.array([t, speed, yaw_rate], dtype=np.float64)
+        i = np.array([bumps, bumps_total], dtype=np.int64)
+        g = cls.__new__(cls)
+        g.__dict__.update(t=f[..., 0], pose=pose, speed=f[..., 1], yaw_rate=f[..., 2], ranges=ranges,
+                          bumps=i[..., 0], bumps_total=i[..., 1])  # fmt: skip
+        return g
+
     def as_dict(self) -> dict[str, np.ndarray]:
         """Field name to array."""
         return {f.name: getattr(self, f.name) for f in fields(self)}

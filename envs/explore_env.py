@@ -36,6 +36,7 @@ from .config import ExploreConfig
 from .coverage import Coverage
 from .episode import GroundTruth
 from .generators import GENERATORS, WorldGenerator
+from .noise_jit import obs_kernel
 from .robot import RobotSim
 from .sensors import SIM_TOL, SensorSuite, measure_step
 from .world import World
@@ -98,6 +99,9 @@ class ExploreEnv(gym.Env):
                 ),
             }
         )
+        self._odo_tops = (float(self._odo_top[0, 0]), float(self._odo_top[1, 0]))
+        hb = self.observation_space["heading"]
+        self._heading_box = (float(hb.low[0]), float(hb.high[0]))
         self.world: World | None = None
         self.sim: RobotSim | None = None
         self.coverage: Coverage | None = None
@@ -189,15 +193,7 @@ class ExploreEnv(gym.Env):
             self.np_random,
             tol=SIM_TOL,
         )
-        truth = GroundTruth(
-            t=self.t,
-            pose=pose,
-            speed=speed,
-            yaw_rate=yaw,
-            ranges=ranges,
-            bumps=bumps,
-            bumps_total=self.sim.bumps,
-        )
+        truth = GroundTruth.of_step(self.t, pose, speed, yaw, ranges, bumps, self.sim.bumps)
         return record, truth
 
     def _reward(self, truth: GroundTruth) -> float:
@@ -218,13 +214,9 @@ class ExploreEnv(gym.Env):
         }
 
     def _obs(self, record: MissionRecord) -> dict[str, np.ndarray]:
-        h = record.heading
-        k = np.round(0.5 * (h[0] + h[1]) / (2 * math.pi)) * 2 * math.pi
-        hb = self.observation_space["heading"]
-        odo = np.array([record.speed, record.yaw_rate])
-        return {
-            "ranges": np.minimum(record.range, self._top),  # lower bounds are >= 0 by construction
-            "no_echo": record.no_echo.astype(np.int8),
-            "odometry": np.minimum(np.maximum(odo, -self._odo_top), self._odo_top),
-            "heading": np.minimum(np.maximum(h - k, hb.low), hb.high),
-        }
+        # lower range bounds are >= 0 by construction; the heading is shifted by a multiple of 2 pi
+        lo, hi = self._heading_box
+        ranges, no_echo, odo, heading = obs_kernel(record.range, record.no_echo, record.speed,
+                                                   record.yaw_rate, record.heading, self._top,
+                                                   self._odo_tops[0], self._odo_tops[1], lo, hi)  # fmt: skip
+        return {"ranges": ranges, "no_echo": no_echo, "odometry": odo, "heading": heading}

@@ -1,4 +1,4 @@
-"""Exact planar geometry on edge soups, vectorised with numpy.
+"""Exact planar geometry on edge soups.
 
 The world's obstacles are described by closed polylines (rings) stored as an edge array ``(E, 4)`` of
 ``x1, y1, x2, y2``. A point is free iff a ray from it crosses the edges an odd number of times (even-odd rule
@@ -8,12 +8,16 @@ The key routine, :func:`sector_distance`, returns the distance from an apex to t
 a circular sector of any half-aperture in ``(0, pi]``. Since a sector is star-shaped about its apex, that is
 the nearest obstacle point in the sector whenever the apex is free. It is exact (no ray fan): per edge, the
 minimum of the convex distance function over the edge's part inside the sector is reached at the foot of
-the perpendicular, at an endpoint inside the sector, or where the edge crosses a boundary ray.
+the perpendicular, at an endpoint inside the sector, or where the edge crosses a boundary ray. The distance
+routines run compiled (:mod:`.geometry_jit`); the numpy versions they replaced are the test oracles of
+``tests/test_sim_jit.py``.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from . import geometry_jit as jit
 
 Edges = np.ndarray  # (E, 4) float64
 
@@ -47,22 +51,16 @@ def point_free(points: np.ndarray, edges: Edges, chunk: int = 2048) -> np.ndarra
 
 
 def point_edge_distance(points: np.ndarray, edges: Edges) -> np.ndarray:
-    """Distance from each point to the nearest edge, shape ``(N,)`` (``inf`` with no edges)."""
-    pts = np.atleast_2d(np.asarray(points, dtype=np.float64))
-    if len(edges) == 0:
-        return np.full(len(pts), np.inf)
-    if len(pts) > 2048:
-        return np.concatenate(
-            [point_edge_distance(pts[i : i + 2048], edges) for i in range(0, len(pts), 2048)]
-        )
-    ax = edges[None, :, 0] - pts[:, :1]
-    ay = edges[None, :, 1] - pts[:, 1:2]
-    dx = (edges[:, 2] - edges[:, 0])[None]
-    dy = (edges[:, 3] - edges[:, 1])[None]
-    dd = dx * dx + dy * dy
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = np.clip(np.where(dd > 0, -(ax * dx + ay * dy) / dd, 0.0), 0.0, 1.0)
-    return np.sqrt(np.min((ax + t * dx) ** 2 + (ay + t * dy) ** 2, axis=1))
+    """Distance from each point to the nearest edge, shape ``(N,)`` (``inf`` with no edges).
+
+    Compiled (:func:`.geometry_jit.points_edges_kernel`); the numpy version it replaced is the test oracle
+    of ``tests/test_sim_jit.py``.
+    """
+    pts = np.ascontiguousarray(np.atleast_2d(np.asarray(points, dtype=np.float64)))
+    e = np.ascontiguousarray(edges, dtype=np.float64).reshape(-1, 4)
+    out = np.empty(len(pts))
+    jit.points_edges_kernel(pts, e, jit.edge_boxes(e), np.inf, out)
+    return out
 
 
 def edges_near(edges: Edges, bbox: np.ndarray, x: float, y: float, reach: float) -> Edges:
@@ -74,15 +72,7 @@ def edges_near(edges: Edges, bbox: np.ndarray, x: float, y: float, reach: float)
 
 def edge_bboxes(edges: Edges) -> np.ndarray:
     """Bounding boxes ``(E, 4)`` of the edges."""
-    return np.stack(
-        [
-            np.minimum(edges[:, 0], edges[:, 2]),
-            np.minimum(edges[:, 1], edges[:, 3]),
-            np.maximum(edges[:, 0], edges[:, 2]),
-            np.maximum(edges[:, 1], edges[:, 3]),
-        ],
-        axis=1,
-    )
+    return jit.edge_boxes(edges)
 
 
 def sector_distance(
@@ -101,52 +91,10 @@ def sector_distance(
     Returns:
         Distances ``(S,)``, ``inf`` where no edge meets the (unbounded) sector.
     """
-    axis = np.asarray(axis, dtype=np.float64)
-    gamma = np.asarray(gamma, dtype=np.float64)
-    S, E = axis.shape[0], len(edges)
-    if E == 0:
-        d = np.full(S, np.inf)
-        return (d, np.full((S, 2), np.nan)) if return_witness else d
-    ax, ay = edges[:, 0] - x, edges[:, 1] - y
-    dx, dy = edges[:, 2] - edges[:, 0], edges[:, 3] - edges[:, 1]
-    # One matrix of edge vectors (2, 5E): endpoints a, b, feet f, then (dy, -dx) and (-ay, ax) for the rays.
-    m = np.empty((2, 5 * E))
-    m[0, :E], m[1, :E] = ax, ay
-    np.add(ax, dx, out=m[0, E : 2 * E])
-    np.add(ay, dy, out=m[1, E : 2 * E])
-    with np.errstate(divide="ignore", invalid="ignore"):  # zero-length edges: NaN feet, never selected
-        t = np.minimum(np.maximum(-(ax * dx + ay * dy) / (dx * dx + dy * dy), 0.0), 1.0)
-        m[0, 2 * E : 3 * E], m[1, 2 * E : 3 * E] = ax + t * dx, ay + t * dy
-        m[0, 3 * E : 4 * E], m[1, 3 * E : 4 * E] = dy, -dx
-        m[0, 4 * E :], m[1, 4 * E :] = -ay, ax
-        # Directions (3S, 2): sector axes u, then boundary rays w (minus rays, then plus rays).
-        ang = np.concatenate([axis, axis - gamma, axis + gamma])
-        dirs = np.empty((3 * S, 2))
-        np.cos(ang, out=dirs[:, 0])
-        np.sin(ang, out=dirs[:, 1])
-        prod = dirs @ m  # (3S, 5E)
-        pts = m[:, : 3 * E]
-        norms = np.hypot(pts[0], pts[1])
-        # angle(u, v) <= gamma  <=>  u.v >= |v| cos(gamma), valid for gamma in (0, pi]: no angle wrapping.
-        inside = prod[:S, : 3 * E] >= norms * np.cos(gamma)[:, None]
-        cand_pts = np.where(inside, norms, np.inf)  # (S, 3E)
-        # Boundary rays r * w (r >= 0) crossing a + s d (s in [0, 1]).
-        den = prod[S:, 3 * E : 4 * E]
-        r = (ax * dy - ay * dx) / den
-        sp = prod[S:, 4 * E :] / den
-        cand_ray = np.where((r >= 0) & (sp >= 0) & (sp <= 1), r, np.inf)  # (2S, E)
-    if not return_witness:
-        return np.minimum(
-            np.minimum(cand_pts.min(axis=1), cand_ray[:S].min(axis=1)), cand_ray[S:].min(axis=1)
-        )
-    allc = np.concatenate([cand_pts, cand_ray[:S], cand_ray[S:]], axis=1)  # (S, 5E)
-    k = np.argmin(allc, axis=1)
-    d = allc[np.arange(S), k]
-    on_ray = k >= 3 * E
-    kp = np.minimum(k, 3 * E - 1)
-    ang = np.where(k >= 4 * E, axis + gamma, axis - gamma)
-    wx = np.where(on_ray, d * np.cos(ang), pts[0, kp]) + x
-    wy = np.where(on_ray, d * np.sin(ang), pts[1, kp]) + y
-    wit = np.stack([wx, wy], axis=1)
-    wit[~np.isfinite(d)] = np.nan
-    return d, wit
+    axis = np.ascontiguousarray(axis, dtype=np.float64).reshape(-1)
+    gamma = np.ascontiguousarray(gamma, dtype=np.float64).reshape(-1)
+    e = np.ascontiguousarray(edges, dtype=np.float64).reshape(-1, 4)
+    d, wit = np.empty(len(axis)), np.empty((len(axis), 2))
+    cut = np.full(len(axis), np.inf)
+    jit.sector_kernel(float(x), float(y), 0.0, axis, gamma, cut, e, jit.edge_boxes(e), np.inf, d, wit)
+    return (d, wit) if return_witness else d

@@ -11,11 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .config import NoiseConfig
-
-
-def _widen(lo: np.ndarray, hi: np.ndarray, scale: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    pad = 4.0 * np.spacing(scale)
-    return lo - pad, hi + pad
+from .noise_jit import MODEL_CODES, noise_kernel
 
 
 def measure(
@@ -24,7 +20,7 @@ def measure(
     cfg: NoiseConfig,
     rng: np.random.Generator,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Noisy measurement of ``truth`` with error bound ``bound``.
+    """Noisy measurement of ``truth`` with error bound ``bound`` (compiled: :func:`.noise_jit.noise_kernel`).
 
     Args:
         truth: True values (finite).
@@ -36,23 +32,12 @@ def measure(
         ``(measured, lo, hi)`` with ``lo <= truth <= hi`` exactly.
     """
     truth = np.asarray(truth, dtype=np.float64)
-    b = np.asarray(bound, dtype=np.float64)
+    b = np.broadcast_to(np.asarray(bound, dtype=np.float64), truth.shape)
     u = rng.uniform(-1.0, 1.0, truth.shape)
-    if cfg.model == "adversarial":
-        side = np.where(u >= 0, 1.0, -1.0)
-        m = truth + side * b
-        far = truth + side * 2.0 * b
-        lo = np.where(side > 0, truth, far)
-        hi = np.where(side > 0, far, truth)
-        plo, phi = _widen(lo, hi, np.maximum(np.abs(truth), 2.0 * b))
-        return m, np.where(side > 0, truth, plo), np.where(side > 0, phi, truth)
-    if cfg.model == "biased":
-        e = (cfg.bias + (1.0 - abs(cfg.bias)) * u) * b
-    else:
-        e = u * b
-    m = truth + e
-    lo, hi = _widen(m - b, m + b, np.maximum(np.abs(m), b))
-    return m, lo, hi
+    m, lo, hi = np.empty(truth.size), np.empty(truth.size), np.empty(truth.size)
+    noise_kernel(np.ascontiguousarray(truth).reshape(-1), np.ascontiguousarray(b).reshape(-1),
+                 u.reshape(-1), MODEL_CODES[cfg.model], float(cfg.bias), m, lo, hi)  # fmt: skip
+    return m.reshape(truth.shape), lo.reshape(truth.shape), hi.reshape(truth.shape)
 
 
 def outliers(

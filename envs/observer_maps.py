@@ -8,6 +8,11 @@ covers cells ``starts[p] <= c < starts[p + 1]`` with ``starts[p] = floor(p n / m
 * it is DARK only if all its cells are dark (certainly not explored);
 * otherwise it is PENUMBRA (mixed or possibly explored: nothing is claimed).
 
+The per-cell work is compiled (``digslam.observer.jit.njit``): :func:`observer_sets` turns the filter's
+certainly / possibly sensed and dug cells into the explored codes, the clear and dark masks and the
+certified count in one pass, and :func:`sets_and_map` keeps them and the image up to date on the window
+of cells a step changed.
+
 >>> clear = np.zeros((4, 4), bool); clear[:2, :2] = True; clear[0, 2] = True
 >>> dark = np.zeros((4, 4), bool); dark[2:, 2:] = True
 >>> c, p, d = three_state(clear, dark, 2)
@@ -17,7 +22,15 @@ covers cells ``starts[p] <= c < starts[p + 1]`` with ``starts[p] = floor(p n / m
 
 from __future__ import annotations
 
+from bisect import bisect_left, bisect_right
+from functools import lru_cache
+
 import numpy as np
+
+from digslam.observer.jit import njit
+from digslam.observer.thick_sep import CLEAR, DARK, PENUMBRA
+
+_CLEAR, _PENUMBRA, _DARK = int(CLEAR), int(PENUMBRA), int(DARK)
 
 
 def block_starts(n: int, m: int) -> np.ndarray:
@@ -25,38 +38,147 @@ def block_starts(n: int, m: int) -> np.ndarray:
     return (np.arange(m, dtype=np.int64) * n) // m
 
 
-def all_blocks(mask: np.ndarray, m: int) -> np.ndarray:
-    """``(m, m)``: True where every cell of the pixel's block is True."""
-    ny, nx = mask.shape
-    if ny % m == 0 and nx % m == 0:  # equal blocks: AND of strided slices (much faster than reductions)
-        by, bx = ny // m, nx // m
-        rows = mask[0::by].copy()
-        for i in range(1, by):
-            rows &= mask[i::by]
-        out = rows[:, 0::bx].copy()
-        for j in range(1, bx):
-            out &= rows[:, j::bx]
-        return out
-    a = np.minimum.reduceat(mask.view(np.uint8), block_starts(ny, m), axis=0)
-    return np.minimum.reduceat(a, block_starts(nx, m), axis=1).astype(bool)
+@lru_cache(maxsize=64)
+def _bounds(n: int, m: int) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
+    """Block ``[start, end)`` of each pixel (a pixel inside one cell when ``n < m``), and the starts."""
+    s = block_starts(n, m)
+    e = np.maximum(np.append(s[1:], n), s + 1)
+    return s, e, tuple(s.tolist())
+
+
+@njit
+def _fill(clear: np.ndarray, dark: np.ndarray, img: np.ndarray, ch: int, rs: np.ndarray, re: np.ndarray,
+          cs: np.ndarray, ce: np.ndarray, p0: int, p1: int, q0: int, q1: int) -> None:  # fmt: skip
+    """Pixels ``[p0:p1, q0:q1]`` of channels ``ch, ch + 1, ch + 2`` of ``img`` (255 / 0): all clear, mixed,
+    all dark per pixel block. The masks come as ``uint8`` views; each block row is first AND-reduced
+    over its cells' rows."""
+    if p0 >= p1 or q0 >= q1:
+        return
+    j0, j1 = cs[q0], ce[q1 - 1]
+    w = j1 - j0
+    ac, ad = np.empty(w, np.uint8), np.empty(w, np.uint8)
+    one, full = np.uint8(1), np.uint8(255)
+    for p in range(p0, p1):  # slices indexed from 0: no wraparound checks, the row loops vectorize
+        cr, dr = clear[rs[p], j0:j1], dark[rs[p], j0:j1]
+        for j in range(w):
+            ac[j] = cr[j]
+            ad[j] = dr[j]
+        for i in range(rs[p] + 1, re[p]):
+            cr, dr = clear[i, j0:j1], dark[i, j0:j1]
+            for j in range(w):
+                ac[j] &= cr[j]
+                ad[j] &= dr[j]
+        o0, o1, o2 = img[ch, p, q0:q1], img[ch + 1, p, q0:q1], img[ch + 2, p, q0:q1]
+        for q in range(q1 - q0):
+            k0, k1 = cs[q0 + q] - j0, ce[q0 + q] - j0
+            c, d = ac[k0], ad[k0]
+            for k in range(k0 + 1, k1):
+                c &= ac[k]
+                d &= ad[k]
+            d &= one ^ c
+            o0[q] = full * c
+            o1[q] = full * (one ^ (c | d))
+            o2[q] = full * d
+
+
+def fill_map(clear: np.ndarray, dark: np.ndarray, img: np.ndarray, ch: int = 0) -> None:
+    """Write the clear / penumbra / dark pixel masks of the cell masks into ``img[ch : ch + 3]`` (0 / 255)."""
+    m = img.shape[-1]
+    rs, re, _ = _bounds(clear.shape[0], m)
+    cs, ce, _ = _bounds(clear.shape[1], m)
+    u8 = [np.ascontiguousarray(v).view(np.uint8) for v in (clear, dark)]
+    _fill(u8[0], u8[1], img, ch, rs, re, cs, ce, 0, rs.size, 0, cs.size)
 
 
 def three_state(clear: np.ndarray, dark: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(clear, penumbra, dark)`` pixel masks of side ``m`` (mutually exclusive, covering every pixel)."""
-    c, d = all_blocks(clear, m), all_blocks(dark, m)
-    return c, ~(c | d), d
+    img = np.empty((3, m, m), dtype=np.uint8)
+    fill_map(np.asarray(clear, dtype=bool), np.asarray(dark, dtype=bool), img)
+    return img[0] > 0, img[1] > 0, img[2] > 0
+
+
+def all_blocks(mask: np.ndarray, m: int) -> np.ndarray:
+    """``(m, m)``: True where every cell of the pixel's block is True."""
+    return three_state(mask, np.zeros_like(mask, dtype=bool), m)[0]
+
+
+@njit
+def _sets(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, reach: np.ndarray, explored: np.ndarray,
+          clear: np.ndarray, dark: np.ndarray, r0: int, r1: int, c0: int, c1: int) -> int:  # fmt: skip
+    """The cells ``[r0:r1, c0:c1]`` of the sets; returns the change of the clear cells inside ``reach``."""
+    n = 0
+    s8, m8, f8, r8 = sure.view(np.uint8), maybe.view(np.uint8), free.view(np.uint8), reach.view(np.uint8)
+    e8, c8, d8 = explored.view(np.uint8), clear.view(np.uint8), dark.view(np.uint8)
+    one, code_dark = np.uint8(1), np.uint8(_DARK & 0xFF)
+    for i in range(r0, r1):  # row slices: indices from 0, so no wraparound checks (the loops vectorize)
+        s_, m_, f_, r_ = s8[i, c0:c1], m8[i, c0:c1], f8[i, c0:c1], r8[i, c0:c1]
+        e_, c_, d_ = e8[i, c0:c1], c8[i, c0:c1], d8[i, c0:c1]
+        for j in range(c_.size):
+            n -= np.int64(c_[j] & r_[j])
+        for j in range(c_.size):
+            s, mb = s_[j], m_[j]
+            c = s & f_[j]
+            e_[j] = (np.uint8(_CLEAR) if s else np.uint8(_PENUMBRA)) if (s | mb) else code_dark
+            c_[j] = c
+            d_[j] = one ^ (s | mb)
+            n += np.int64(c & r_[j])
+    return n
+
+
+@njit
+def _sets_and_map(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, reach: np.ndarray,
+                  explored: np.ndarray, clear: np.ndarray, dark: np.ndarray, img: np.ndarray, rs: np.ndarray,
+                  re: np.ndarray, cs: np.ndarray, ce: np.ndarray, r0: int, r1: int, c0: int, c1: int,
+                  p0: int, p1: int, q0: int, q1: int) -> int:  # fmt: skip
+    n = _sets(sure, maybe, free, reach, explored, clear, dark, r0, r1, c0, c1)
+    _fill(clear.view(np.uint8), dark.view(np.uint8), img, 0, rs, re, cs, ce, p0, p1, q0, q1)
+    return n
+
+
+def _check_sets(arrays: tuple[np.ndarray, ...]) -> None:
+    shape = arrays[0].shape
+    if not all(v.flags.c_contiguous and v.shape == shape and v.itemsize == 1 for v in arrays):
+        names = "sure, maybe, free, reach, explored, clear, dark"
+        raise ValueError(f"{names}: expected C-contiguous one-byte arrays of shape {shape}")
+
+
+def observer_sets(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, reach: np.ndarray,
+                  explored: np.ndarray, clear: np.ndarray, dark: np.ndarray) -> int:  # fmt: skip
+    """One pass over the filter's ``(ny, nx)`` bool cells (all C-contiguous): the explored codes (CLEAR
+    certainly sensed, PENUMBRA possibly, DARK not) into the int8 ``explored``, the clear mask (certainly
+    sensed and proved free) and the dark mask into the bool ``clear`` and ``dark``; returns the number of
+    clear cells inside ``reach``."""
+    _check_sets((sure, maybe, free, reach, explored, clear, dark))
+    clear[:] = False
+    return int(_sets(sure, maybe, free, reach, explored, clear, dark, 0, sure.shape[0], 0, sure.shape[1]))
+
+
+def sets_and_map(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, reach: np.ndarray,
+                 explored: np.ndarray, clear: np.ndarray, dark: np.ndarray, img: np.ndarray,
+                 window: tuple[int, int, int, int]) -> int:  # fmt: skip
+    """:func:`observer_sets` then :func:`fill_map` into ``img[0:3]``, restricted to the cells of ``window``
+    ``(r0, r1, c0, c1)`` and the pixels whose blocks meet it (the rest is kept: the cells outside did not
+    change); returns the change of the count. No argument checks: the wrapper's own arrays."""
+    ny, nx = sure.shape
+    m = img.shape[-1]
+    rs, re, _ = _bounds(ny, m)
+    cs, ce, _ = _bounds(nx, m)
+    r0, r1, c0, c1 = window
+    p0, p1 = pixel_range(r0, r1, ny, m)
+    q0, q1 = pixel_range(c0, c1, nx, m)
+    return int(_sets_and_map(sure, maybe, free, reach, explored, clear, dark, img, rs, re, cs, ce, r0, r1, c0,
+                             c1, p0, p1, q0, q1))  # fmt: skip
 
 
 def pixel_range(r0: int, r1: int, n: int, m: int) -> tuple[int, int]:
     """Pixels ``p0:p1`` whose blocks meet the cells ``r0:r1`` (empty when ``r0 >= r1``)."""
     if r0 >= r1:
         return 0, 0
-    s = block_starts(n, m)
-    p0 = int(np.searchsorted(s, r0, side="right")) - 1
-    p1 = int(np.searchsorted(s, r1 - 1, side="right"))
+    s = _bounds(n, m)[2]
+    p0 = bisect_right(s, r0) - 1
+    p1 = bisect_right(s, r1 - 1)
     if n < m:  # several pixels share a cell: take them all
-        p0 = int(np.searchsorted(s, s[p0], side="left"))
-        p1 = int(np.searchsorted(s, r1 - 1, side="right"))
+        p0 = bisect_left(s, s[p0])
     return max(p0, 0), min(p1, m)
 
 

@@ -44,11 +44,11 @@ from scipy import ndimage
 from digslam.observer.grid import Grid
 from digslam.observer.online import OnlineConfig, OnlineDigSlam
 from digslam.observer.record import MissionRecord
-from digslam.observer.thick_sep import DARK, PENUMBRA
+from digslam.observer.thick_sep import PENUMBRA
 
 from .monitor import GuaranteeMonitor
 from .observer_config import ObserverConfig
-from .observer_maps import crop_window, pixel_range, three_state
+from .observer_maps import crop_window, fill_map, pixel_range, sets_and_map
 from .raster import FREE, rasterize
 from .world import World
 
@@ -131,11 +131,15 @@ class GuaranteedObserver(gym.Wrapper):
         self.cell_area = g.cell_size[0] * g.cell_size[1]
         self._centre = 0.5 * (np.array(g.lo) + np.array(g.hi))
         self._half = 0.5 * (np.array(g.hi) - np.array(g.lo))
+        self._centre_half = (tuple(self._centre.tolist()), tuple(self._half.tolist()))
         self._reach_world: Any = None
         self.reachable = np.zeros(g.shape, dtype=bool)
         self.monitor: GuaranteeMonitor | None = None
         self.steps, self._cache_step = 0, -1
-        self._cache: tuple[np.ndarray, np.ndarray] = (np.zeros(0), np.zeros(0))
+        self._cache: tuple[np.ndarray, np.ndarray, np.ndarray, int] = (np.zeros(0),) * 3 + (0,)
+        m, shape = cfg.map_size, g.shape
+        self._explored_all, self._clear_all = np.empty(shape, np.int8), np.zeros(shape, bool)
+        self._dark_all, self._base, self._n = np.empty(shape, bool), np.zeros((3, m, m), np.uint8), 0
 
     # --- gymnasium API -------------------------------------------------------------------------------------
     def reset(self, **kwargs: Any) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
@@ -185,34 +189,42 @@ class GuaranteedObserver(gym.Wrapper):
         if self.monitor is not None:
             self.monitor.check(self.filter, info["truth"], info["record"], self.steps)
 
-    def _sets(self) -> tuple[np.ndarray, np.ndarray]:
-        """The filter's explored codes and clear mask, computed once per step."""
+    def _sets(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+        """The filter's explored codes, clear and dark masks and certified cell count, once per step, with
+        the map's clear / penumbra / dark channels. Kept up to date on the cells the step touched
+        (:meth:`OnlineDigSlam.take_touched`); ``info`` gets copies."""
         if self._cache_step != self.steps:
-            self._cache = (self.filter.explored(), self.filter.clear_mask())
+            f, (ny, nx) = self.filter, self.grid.shape
+            win = f.take_touched()
+            if win == (0, ny, 0, nx):  # after a reset: everything (and the reachable area may be new)
+                self._clear_all[:] = False
+                self._n = 0
+            self._n += sets_and_map(f.sensed_sure, f.sensed_maybe, f.dig.free, self.reachable,
+                                    self._explored_all, self._clear_all, self._dark_all, self._base,
+                                    win)  # fmt: skip
+            self._cache = (self._explored_all.copy(), self._clear_all.copy(), self._dark_all, self._n)
             self._cache_step = self.steps
         return self._cache
 
     def _certified_count(self) -> int:
-        if not self.filter.consistent:
-            return 0
-        return int(np.count_nonzero(self._sets()[1] & self.reachable))
+        """Clear cells in the reachable free area (0 once the claims are withdrawn)."""
+        return self._sets()[3] if self.filter.consistent else 0
 
     def observation(self) -> dict[str, np.ndarray]:
         """The ``"map"`` and ``"state"`` of the filter's current sets (serves reset and step)."""
         f, m, g = self.filter, self.obs_config.map_size, self.grid
-        img = np.zeros((self.n_channels, m, m), dtype=np.uint8)
         state = np.zeros(N_STATE, dtype=np.float32)
         if not f.consistent:  # claims withdrawn: everything is penumbra
+            img = np.zeros((self.n_channels, m, m), dtype=np.uint8)
             img[1] = 255
             return {"map": img, "state": state}
-        explored, clear = self._sets()
-        dark = explored == DARK
-        for ch, mask in enumerate(three_state(clear, dark, m)):
-            img[ch][mask] = 255
+        _, clear, dark, n = self._sets()
+        img = np.zeros((self.n_channels, m, m), dtype=np.uint8)
+        img[:3] = self._base
         lo, hi = f.pose_lo, f.pose_hi
-        (r0,), (r1,), (c0,), (c1,) = g.window(lo[None], hi[None])
-        p0, p1 = pixel_range(int(r0), int(r1), g.shape[0], m)
-        q0, q1 = pixel_range(int(c0), int(c1), g.shape[1], m)
+        r0, r1, c0, c1 = f.dig.win(lo, hi)
+        p0, p1 = pixel_range(r0, r1, g.shape[0], m)
+        q0, q1 = pixel_range(c0, c1, g.shape[1], m)
         img[3, p0:p1, q0:q1] = 255
         crop = self.obs_config.crop
         if crop is not None:
@@ -221,33 +233,31 @@ class GuaranteedObserver(gym.Wrapper):
             rc = int(Grid.count_below(-g.ys, np.array([-ctr[1]]))[0]) - 1
             cc = int(Grid.count_below(g.xs, np.array([ctr[0]]))[0]) - 1
             a, b = rc - k // 2, cc - k // 2
-            cw, dw = crop_window(clear, a, b, k, False), crop_window(dark, a, b, k, True)
-            for ch, mask in enumerate(three_state(cw, dw, m)):
-                img[4 + ch][mask] = 255
-        box = np.clip((np.concatenate([lo, hi]) - np.tile(self._centre, 2)) / np.tile(self._half, 2), -1, 1)
-        hm, hw = 0.5 * (f.heading_lo + f.heading_hi), 0.5 * (f.heading_hi - f.heading_lo)
-        state[:4] = box
-        state[4:7] = math.cos(hm), math.sin(hm), min(hw / math.pi, 1.0)
-        state[7] = math.tanh(float(np.max(hi - lo)))
-        state[8] = min(self.steps / self.obs_config.horizon, 1.0)
-        state[9] = self._certified_count() / self.n_reachable
-        state[10] = 1.0
+            fill_map(crop_window(clear, a, b, k, False), crop_window(dark, a, b, k, True), img, 4)
+        (x0, y0), (x1, y1) = lo.tolist(), hi.tolist()
+        (cx, cy), (hx, hy) = self._centre_half
+        h0, h1 = float(f.heading_lo), float(f.heading_hi)
+        hm, hw = 0.5 * (h0 + h1), 0.5 * (h1 - h0)
+        state[:] = (min(max((x0 - cx) / hx, -1.0), 1.0), min(max((y0 - cy) / hy, -1.0), 1.0),
+                    min(max((x1 - cx) / hx, -1.0), 1.0), min(max((y1 - cy) / hy, -1.0), 1.0),
+                    math.cos(hm), math.sin(hm), min(hw / math.pi, 1.0), math.tanh(max(x1 - x0, y1 - y0)),
+                    min(self.steps / self.obs_config.horizon, 1.0), n / self.n_reachable, 1.0)  # fmt: skip
         return {"map": img, "state": state}
 
     def _obs_info(self, info: dict[str, Any]) -> dict[str, Any]:
         f = self.filter
         out = dict(info)
         ok = bool(f.consistent)
-        explored, clear = (
-            self._sets() if ok else (np.full(self.grid.shape, PENUMBRA), np.zeros(self.grid.shape, bool))
-        )
-        n = int(np.count_nonzero(clear & self.reachable))
+        if ok:
+            explored, clear, _, n = self._sets()
+        else:
+            explored, clear, n = np.full(self.grid.shape, PENUMBRA), np.zeros(self.grid.shape, bool), 0
         out.update(
             explored=explored,
             dig=f.dig.free.copy() if ok else np.zeros(self.grid.shape, dtype=bool),
             clear=clear,
-            pose_box=np.stack([f.pose_lo, f.pose_hi]) if ok else np.full((2, 2), np.nan),
-            heading_box=np.array([f.heading_lo, f.heading_hi]) if ok else np.full(2, np.nan),
+            pose_box=np.array([f.pose_lo.tolist(), f.pose_hi.tolist()]) if ok else np.full((2, 2), np.nan),
+            heading_box=np.array([f.heading_lo, f.heading_hi], np.float64) if ok else np.full(2, np.nan),
             certified_coverage=n / self.n_reachable,
             clear_area=n * self.cell_area,
             true_coverage=float(info.get("coverage", 0.0)),

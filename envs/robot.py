@@ -7,7 +7,7 @@ at that speed scaled by the largest fraction in ``(1/2, 1/4, 1/8, 0)`` whose swe
 checked at the midpoints of ``m`` equal pieces of the arc with a margin of half a piece's travel (every
 point of the arc lies within that of a midpoint), so the nominal disc never overlaps an obstacle and never
 tunnels. Rotation in place is always allowed (the disc does not move). A bump is a step that gets blocked
-after an unblocked one.
+after an unblocked one. Each step runs compiled (:mod:`.robot_jit`).
 
 An earlier version drove the robot through pymunk joints: the body's velocity then lagged its heading (by up
 to 0.5 rad on reversals) and slid along walls, motions that no unicycle with the recorded heading explains,
@@ -22,7 +22,8 @@ import math
 import numpy as np
 import pymunk
 
-from . import geometry as geo
+from . import geometry_jit as gjit
+from .robot_jit import robot_step_kernel
 from .world import World
 
 ROBOT_TYPE, WALL_TYPE = 1, 2
@@ -30,25 +31,12 @@ ROBOT_TYPE, WALL_TYPE = 1, 2
 FRACTIONS = (1.0, 0.5, 0.25, 0.125)
 #: Sweep check points per substep.
 SWEEP_POINTS = 4
-
-
-def arcs(pose: np.ndarray, v: float | np.ndarray, w: float, tau: np.ndarray) -> np.ndarray:
-    """Exact unicycle poses ``(..., len(tau), 3)`` after ``tau`` s of constant ``(v, ω)`` from ``pose``
-    (``v`` a scalar or an array of speeds, broadcast against ``tau``)."""
-    x, y, th = (float(c) for c in pose)
-    v = np.asarray(v, dtype=np.float64)[..., None] if np.ndim(v) else float(v)
-    th2 = th + w * tau
-    if abs(w) < 1e-12:
-        px, py = x + v * tau * math.cos(th), y + v * tau * math.sin(th)
-    else:
-        k = v / w
-        px, py = x + k * (np.sin(th2) - math.sin(th)), y - k * (np.cos(th2) - math.cos(th))
-    th2 = np.broadcast_to(th2, np.shape(px))
-    return np.stack([px, py, th2], axis=-1)
+_FRACTIONS = np.array(FRACTIONS[1:])
 
 
 def arc(pose: np.ndarray, v: float, w: float, tau: float) -> np.ndarray:
-    """:func:`arcs` for one scalar ``tau`` (plain floats, same formulas)."""
+    """Exact unicycle pose after ``tau`` s of constant ``(v, ω)`` from ``pose`` (plain floats; the compiled
+    step :func:`.robot_jit.robot_step_kernel` uses the same formulas)."""
     x, y, th = (float(c) for c in pose)
     th2 = th + w * tau
     if abs(w) < 1e-12:
@@ -103,7 +91,9 @@ class RobotSim:
         self.space.add(self.body, self.shape, self.control, pivot, gear)
         self.bumps = 0
         self.space.on_collision(ROBOT_TYPE, WALL_TYPE, begin=self._on_bump)
-        self.radius, self.edges, self.bbox = float(radius), world.edges, world.bbox
+        self.radius = float(radius)
+        self.edges = np.ascontiguousarray(world.edges, dtype=np.float64)
+        self.bbox = gjit.edge_boxes(self.edges)
         self._pose = np.array([float(pose[0]), float(pose[1]), float(pose[2])])
         self._v, self._w, self._blocked = 0.0, 0.0, False
         self.speed_hull: tuple[float, float] = (0.0, 0.0)
@@ -112,58 +102,31 @@ class RobotSim:
     def _on_bump(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
         pass  # contacts of the reference pymunk loop (benchmarks) are not the robot's bumps
 
-    def _sweep_ok(self, pose: np.ndarray, vs: np.ndarray, w: float, tau: np.ndarray, piece: float,
-                  edges: np.ndarray) -> np.ndarray:  # fmt: skip
-        """``(len(vs), len(tau))``: whether the disc centred at the arc points ``tau`` (midpoints of pieces of
-        duration ``piece``) keeps ``radius`` plus half a piece's travel off every edge."""
-        mids = arcs(pose, vs, w, tau)
-        d = geo.point_edge_distance(mids[..., :2].reshape(-1, 2), edges).reshape(len(vs), len(tau))
-        return d >= self.radius + np.abs(vs)[:, None] * (0.5 * piece)
-
     def step(self, v: float, omega: float, dt: float, substeps: int) -> int:
         """Advance ``dt`` seconds under command ``(v, omega)``; return the bumps that occurred.
 
         The substeps before the first blocked one run at full speed; the rest of the step runs at the
-        largest fraction of :data:`FRACTIONS` (or 0) whose sweep is clear, as one arc. Afterwards
-        :attr:`speed_hull` and :attr:`yaw_hull` hold the hull of the true speed and yaw rate over the
-        whole step.
+        largest fraction of :data:`FRACTIONS` (or 0) whose sweep is clear, as one arc (compiled,
+        :func:`.robot_jit.robot_step_kernel`). Afterwards :attr:`speed_hull` and :attr:`yaw_hull` hold the
+        hull of the true speed and yaw rate over the whole step.
         """
-        before = self.bumps
-        h = dt / substeps
-        m = SWEEP_POINTS
-        x, y = float(self._pose[0]), float(self._pose[1])
-        edges = geo.edges_near(self.edges, self.bbox, x, y, abs(v) * dt + self.radius + 1e-9)
-        first = substeps
-        # fast path: every point of the step's arc lies within |v| dt of the start (a chord is never longer
-        # than its arc), so a start clearance above radius + |v| dt clears the whole sweep
-        clear = not len(edges) or float(geo.point_edge_distance(self._pose[None, :2], edges)[0]) > (
-            self.radius + abs(v) * dt * (1.0 + 1e-9) + 1e-9
-        )
-        if v != 0.0 and not clear:
-            tau = (np.arange(substeps * m) + 0.5) * (h / m)
-            ok = self._sweep_ok(self._pose, np.array([v]), omega, tau, h / m, edges)[0]
-            if not ok.all():
-                first = int(np.argmin(ok)) // m
-        used = [v] * first
-        if first:
-            self._pose = arc(self._pose, v, omega, first * h)
+        v, omega = float(v), float(omega)
+        first, vi = robot_step_kernel(self._pose, v, omega, float(dt), int(substeps), SWEEP_POINTS,
+                                      self.radius, self.edges, self.bbox, _FRACTIONS)  # fmt: skip
         rest = substeps - first
-        if rest:
-            vs = v * np.array(FRACTIONS[1:])
-            tau = (np.arange(rest * m) + 0.5) * (h / m)
-            ok = self._sweep_ok(self._pose, vs, omega, tau, h / m, edges).all(axis=1)
-            vi = float(vs[int(np.argmax(ok))]) if ok.any() else 0.0
-            self._pose = arc(self._pose, vi, omega, rest * h)
-            used += [vi] * rest
-            if not self._blocked:
-                self.bumps += 1
+        bumped = rest > 0 and not self._blocked
+        if bumped:
+            self.bumps += 1
         self._blocked = rest > 0
-        self._v, self._w = used[-1], float(omega)
-        self.speed_hull = (min(used), max(used))
-        self.yaw_hull = (float(omega), float(omega))
+        if rest and first:
+            self.speed_hull = (min(v, vi), max(v, vi))
+        else:
+            self.speed_hull = (vi, vi) if rest else (v, v)
+        self._v, self._w = (vi if rest else v), omega
+        self.yaw_hull = (omega, omega)
         self.body.position = (float(self._pose[0]), float(self._pose[1]))
         self.body.angle = float(self._pose[2])
-        return self.bumps - before
+        return int(bumped)
 
     @property
     def pose(self) -> np.ndarray:

@@ -1,12 +1,13 @@
 """Exact sensors (sonar cones, omnidirectional range, odometry, compass) and the step's measurement record.
 
-Range truth is geometric (:func:`geometry.sector_distance` over the edges pre-filtered by bounding boxes),
-never a ray fan. The omnidirectional sensor is a cone of half-aperture ``pi``.
+Range truth is geometric (the exact sector distance of :mod:`.geometry` over the edges pre-filtered by
+bounding boxes), never a ray fan. The omnidirectional sensor is a cone of half-aperture ``pi``.
 
 Odometry may be given as a hull ``(lo, hi)`` of the true values over a time slice (the env passes the hull
 over every physics substep of the step that just ended); the reported interval then contains the whole hull.
 ``tol`` widens every finite bound by ``tol * max(1, |bound|)`` to cover the simulator's own float64 rounding
-(:data:`SIM_TOL`, the same widening as :data:`digslam.envs.missions.SIM_TOL`).
+(:data:`SIM_TOL`, the same widening as :data:`digslam.envs.missions.SIM_TOL`). Ranges, noise and widening
+run compiled (:mod:`.geometry_jit`, :mod:`.noise_jit`).
 """
 
 from __future__ import annotations
@@ -18,26 +19,23 @@ import numpy as np
 
 from digslam.observer.record import MissionRecord
 
-from . import geometry as geo
+from . import geometry_jit as gjit
 from .config import ExploreConfig, NoiseConfig
-from .noise import measure, outliers
+from .noise import outliers
+from .noise_jit import MODEL_CODES, record_kernel
 from .world import World
 
 #: Relative (absolute below magnitude 1) widening of the env's records for the simulator's float rounding.
 SIM_TOL = 1e-12
 
 Hull = float | tuple[float, float]
+_ROWS = ("speed", "yaw_rate", "heading")
 
 
 def _hull(v: Hull) -> tuple[float, float]:
     if isinstance(v, tuple):
         return float(v[0]), float(v[1])
     return float(v), float(v)
-
-
-def _pad(v: np.ndarray, tol: float, up: bool) -> np.ndarray:
-    pad = tol * np.maximum(1.0, np.abs(np.where(np.isfinite(v), v, 0.0)))
-    return v + pad if up else v - pad
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,6 +63,12 @@ class SensorSuite:
             raise ValueError(f"gamma: cone apertures must be in (0, pi], got {self.gamma.tolist()}")
         if np.any(~(self.r_max > 0)) or not np.all(np.isfinite(self.r_max)):
             raise ValueError(f"r_max: maximum ranges must be finite and > 0, got {self.r_max.tolist()}")
+        object.__setattr__(self, "_reach", float(self.r_max.max()) if self.n else 0.0)
+        object.__setattr__(self, "_wit", np.empty((self.n, 2)))  # scratch of true_ranges (witnesses unused)
+        # writeable copies for the compiled kernels: numba types read-only arrays apart, and one signature per
+        # kernel keeps the first (uncached) compilation short
+        for name in ("alpha", "gamma", "r_max"):
+            object.__setattr__(self, "_k_" + name, getattr(self, name).copy())
 
     @classmethod
     def from_config(cls, cfg: ExploreConfig) -> SensorSuite:
@@ -83,11 +87,15 @@ class SensorSuite:
         return len(self.alpha)
 
     def true_ranges(self, world: World, pose: np.ndarray) -> np.ndarray:
-        """Exact distance to the nearest obstacle point in each sector; ``inf`` beyond ``r_max`` (no echo)."""
-        x, y, th = float(pose[0]), float(pose[1]), float(pose[2])
-        edges = geo.edges_near(world.edges, world.bbox, x, y, float(self.r_max.max()))
-        d = geo.sector_distance(x, y, th + self.alpha, self.gamma, edges)
-        return np.where(d <= self.r_max, d, np.inf)
+        """Exact distance to the nearest obstacle point in each sector; ``inf`` beyond ``r_max`` (no echo).
+
+        One compiled pass over the world's edges (:func:`.geometry_jit.sector_kernel`), pre-filtered by their
+        bounding boxes against the largest range.
+        """
+        d = np.empty(self.n)
+        gjit.sector_kernel(float(pose[0]), float(pose[1]), float(pose[2]), self._k_alpha, self._k_gamma,
+                           self._k_r_max, world.edges, world.bbox, self._reach, d, self._wit)  # fmt: skip
+        return d
 
 
 def measure_step(
@@ -109,42 +117,47 @@ def measure_step(
     amount whatever the values, so runs stay reproducible.
     """
     (s_lo, s_hi), (w_lo, w_hi) = _hull(speed), _hull(yaw_rate)
-    half = np.array([0.5 * (s_hi - s_lo), 0.5 * (w_hi - w_lo)])
-    speed, yaw_rate = 0.5 * (s_lo + s_hi), 0.5 * (w_lo + w_hi)
-    no_echo = ~np.isfinite(ranges)
     n = suite.n
-    truth = np.empty(n + 3)
-    truth[:3] = speed, yaw_rate, heading
-    truth[3:] = np.where(no_echo, 0.0, ranges)
-    bounds = np.empty(n + 3)
-    bounds[:3] = noise.speed, noise.yaw_rate, noise.heading
-    bounds[3:] = noise.range
-    _, lo, hi = measure(truth, bounds, noise, rng)
-    out = np.empty((n + 3, 2))  # rows: speed, yaw rate, heading, then the ranges
-    out[:, 0], out[:, 1] = lo, hi
-    out[:2, 0] -= half
-    out[:2, 1] += half
-    out[:2, 0] = np.minimum(out[:2, 0], [s_lo, w_lo])  # exact containment despite the rounding of +-half
-    out[:2, 1] = np.maximum(out[:2, 1], [s_hi, w_hi])
-    rng_out = out[3:]
-    rng_out[:, 0] = np.where(no_echo, suite.r_max, np.maximum(lo[3:], 0.0))
-    rng_out[no_echo, 1] = np.inf
+    r = np.ascontiguousarray(ranges, dtype=np.float64)
+    if r.shape != (n,):
+        raise ValueError(f"ranges: expected shape ({n},), got {r.shape}")
+    u = rng.uniform(-1.0, 1.0, n + 3)
     if noise.outlier_prob > 0:
         flag, o_lo, o_hi = outliers(n, noise.outlier_prob, suite.r_max, noise.range, rng)
-        rng_out[flag, 0], rng_out[flag, 1] = o_lo[flag], o_hi[flag]
     else:
         flag = np.zeros(n, dtype=bool)
-    if tol > 0:
-        out[:, 0], out[:, 1] = _pad(out[:, 0], tol, False), _pad(out[:, 1], tol, True)
-    return MissionRecord(
-        t=np.float64(t),
+        o_lo = o_hi = suite._k_r_max
+    out, no_echo = np.empty((n + 3, 2)), np.empty(n, dtype=bool)
+    bad = record_kernel(r, suite._k_r_max, s_lo, s_hi, w_lo, w_hi, float(heading), float(noise.speed),
+                        float(noise.yaw_rate), float(noise.heading), float(noise.range), u,
+                        MODEL_CODES[noise.model], float(noise.bias), flag, o_lo, o_hi, float(tol), out,
+                        no_echo)  # fmt: skip
+    if bad >= 0:
+        name = _ROWS[bad] if bad < 3 else f"range[{bad - 3}]"
+        raise ValueError(f"{name}: interval is not [lo <= hi]: {out[bad].tolist()}")
+    t = float(t)
+    if not math.isfinite(t):
+        raise ValueError("t: times must be finite")
+    return _record(t, out, suite, no_echo, flag)
+
+
+def _record(
+    t: float, out: np.ndarray, suite: SensorSuite, no_echo: np.ndarray, flag: np.ndarray
+) -> MissionRecord:
+    """A :class:`MissionRecord` built from arrays already of the right dtype and shape, whose intervals
+    :func:`record_kernel` has checked: the same fields as ``MissionRecord(...)``, without re-running its
+    per-field conversions and checks each step (``tests/test_sim_jit.py`` checks the two agree)."""
+    rec = MissionRecord.__new__(MissionRecord)
+    rec.__dict__.update(
+        t=np.asarray(t, dtype=np.float64),
         speed=out[0],
         yaw_rate=out[1],
         heading=out[2],
         alpha=suite.alpha,
         gamma=suite.gamma,
         r_max=suite.r_max,
-        range=rng_out,
-        no_echo=no_echo & ~flag,
+        range=out[3:],
+        no_echo=no_echo,
         outlier=flag,
     )
+    return rec

@@ -51,7 +51,7 @@ class World:
         """Build from a closed edge soup (e.g. traced contours); ``rings`` are chained where possible."""
         w = cls(frame, [], name)
         w.rings = chain_rings(np.asarray(edges, dtype=np.float64).reshape(-1, 4)) or []
-        w.edges = np.asarray(edges, dtype=np.float64).reshape(-1, 4)
+        w.edges = np.ascontiguousarray(edges, dtype=np.float64).reshape(-1, 4)
         w.bbox = geo.edge_bboxes(w.edges)
         return w
 

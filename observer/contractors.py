@@ -22,6 +22,8 @@ from .backward import BACKWARD
 from .boxes import chunked, empty_rows, normalize_empty, validate_batch
 from .expr import Function
 from .interval import IntervalArray, as_pair
+from .jit_hc4 import hc4
+from .jit_tape import Tape
 
 Batch = tuple[np.ndarray, np.ndarray]
 
@@ -144,7 +146,10 @@ class CtcFwdBwd(Ctc):
         y: the image set: an interval, a box of dimension ``m``, a number, or ``(lo, hi)`` bounds.
 
     One call runs one forward pass (natural inclusion of every node), intersects the outputs with
-    ``[y]``, and one backward pass (projection rules of :mod:`.backward`) down to the variables.
+    ``[y]``, and one backward pass (projection rules of :mod:`.backward`) down to the variables:
+    compiled (:mod:`.jit_hc4`) when ``f`` has a :class:`~.jit_tape.Tape`, else with numpy
+    (:func:`hc4_backward`, which also serves the functions with trigonometric, ``min``/``max`` or
+    ``atan2`` nodes).
     """
 
     def __init__(self, f: Function | Any, y: Any) -> None:
@@ -160,6 +165,9 @@ class CtcFwdBwd(Ctc):
         self.y = (ylo.astype(np.float64), yhi.astype(np.float64))
 
     def contract(self, lo: np.ndarray, hi: np.ndarray) -> Batch:
+        tape = Tape.of(self.f)
+        if tape is not None:
+            return hc4(tape, lo, hi, *self.y)
         return chunked(lambda a, b: hc4_backward(self.f, self.f.forward(a, b), self.y, a, b), lo, hi)
 
 

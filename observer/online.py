@@ -5,11 +5,14 @@ Each :meth:`OnlineDigSlam.update` takes the next single-step record and
 1. predicts ``ψ_k ∈ [ψ_{k-1}] + [dt]·[ω_k]`` (intersected with the compass) and the heading over the
    slice, then ``x_k ∈ x_{k-1} + [dt]·[v_k] (cos, sin)([ψ] on the slice)`` (Eq. 6.23; record ``k``'s speed
    and yaw rate bound the truth over the slice ``[t_{k-1}, t_k]`` that ends at it: the data contract of
-   :mod:`digslam.observer.record`); scalar outward rounding, each correctly rounded operation is stepped one
-   ulp outward (``math.nextafter``), ``cos``/``sin`` widened by more than :data:`~.rounding.LIBM_ULPS`;
-2. contracts the box with the impacts ``dist(x_k, comp M⁻) <= y⁺`` (Eq. 6.22) on a window;
+   :mod:`digslam.observer.record`); compiled scalar outward rounding (:func:`.online_jit_pose.predict`),
+   each correctly rounded operation stepped one ulp outward, ``cos``/``sin`` widened by more than
+   :data:`~.rounding.LIBM_ULPS`;
+2. contracts the box with the impacts ``dist(x_k, comp M⁻) <= y⁺`` (Eq. 6.22) on a window
+   (:func:`.online_jit_pose.contract`);
 3. digs ``M⁻ := M⁻ ∪ g⁻¹_{[x_k]}(Z⁻)`` (Eq. 6.21) and grows the explored zone: certainly sensed =
-   dug, possibly sensed = not proved outside every sensed sector (:mod:`.online_explored`);
+   dug, possibly sensed = not proved outside every sensed sector, one compiled pass over the cells in
+   sensor reach (:func:`.online_jit_mark.dig_and_mark`);
 4. optionally (``smoothing_window = W``) contracts the last ``W`` boxes backward,
    ``x_j &= x_{j+1} - [d_j]``, and digs again the readings of the boxes that shrank.
 
@@ -41,45 +44,16 @@ import numpy as np
 
 from . import rounding as rnd
 from .grid import Grid
-from .online_explored import WindowDigMap, mark_possibly_sensed
+from .online_explored import WindowDigMap
+from .online_jit_mark import dig_and_mark
+from .online_jit_pose import cos_sin as _cos_sin  # noqa: F401  (re-exported: the tests use it)
+from .online_jit_pose import impact_bound, predict
 from .record import MissionRecord
 from .thick_sep import CLEAR, DARK, PENUMBRA
 
 __all__ = ["OnlineConfig", "OnlineDigSlam"]
 
 _INF = math.inf
-#: Absolute widening of a libm ``cos``/``sin`` value (``|v| <= 1``): 4 ulps of 1 plus the subtraction's.
-_TRIG_PAD = 2e-15
-
-
-def _up(x: float) -> float:
-    return math.nextafter(x, _INF)
-
-
-def _dn(x: float) -> float:
-    return math.nextafter(x, -_INF)
-
-
-def _mul(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
-    """Outward-rounded product of two finite intervals."""
-    p = (al * bl, al * bh, ah * bl, ah * bh)
-    return _dn(min(p)), _up(max(p))
-
-
-def _cos_sin(a: float, b: float) -> tuple[float, float, float, float]:
-    """Enclosures ``(cos⁻, cos⁺, sin⁻, sin⁺)`` over ``[a, b]``: endpoints widened, plus every extremum
-    ``m·π/2`` that may lie in ``[a, b]`` (slack on the float multiple of ``π/2``)."""
-    m0, m1 = math.floor(a / rnd.HALF_PI_UP) - 1, math.floor(b / rnd.HALF_PI_DOWN) + 1
-    if m1 - m0 > 8:
-        return -1.0, 1.0, -1.0, 1.0
-    ca, cb, sa, sb = math.cos(a), math.cos(b), math.sin(a), math.sin(b)
-    c = [min(ca, cb) - _TRIG_PAD, max(ca, cb) + _TRIG_PAD, min(sa, sb) - _TRIG_PAD, max(sa, sb) + _TRIG_PAD]
-    for m in range(m0, m1 + 1):
-        p = m * rnd.HALF_PI_DOWN
-        eps = abs(p) * 1e-15 + 1e-300
-        if a - eps <= p <= b + eps:
-            c[(1, 3, 0, 2)[m % 4]] = (1.0, 1.0, -1.0, -1.0)[m % 4]  # cos max, sin max, cos min, sin min
-    return max(c[0], -1.0), min(c[1], 1.0), max(c[2], -1.0), min(c[3], 1.0)
 
 
 @dataclass(frozen=True)
@@ -126,6 +100,7 @@ class OnlineDigSlam:
         consistent, inconsistent_step: False and the step index (``reset`` is step 0) once the data
             contradicted their bounds; the sets then carry no guarantee and ``update`` does nothing.
         steps: steps folded in (``reset`` counts one); last_update_seconds: wall time of the last update.
+        touched: window ``(r0, r1, c0, c1)`` of the cells changed since :meth:`take_touched`.
     """
 
     def __init__(self, grid: Grid, config: OnlineConfig | None = None) -> None:
@@ -147,6 +122,7 @@ class OnlineDigSlam:
         self.steps, self.last_update_seconds = 0, 0.0
         self._prev: MissionRecord | None = None
         self._ring.clear()
+        self.touched = (0, self.grid.shape[0], 0, self.grid.shape[1])
 
     def _check_record(self, rec: Any, name: str = "rec") -> MissionRecord:
         if not isinstance(rec, MissionRecord) or rec.t.ndim != 0:
@@ -182,30 +158,21 @@ class OnlineDigSlam:
         if not self.consistent:
             return
         start = time.perf_counter()
-        p = self._prev
-        dt = float(rec.t) - float(p.t)
-        dtl, dth = _dn(dt), _up(dt)
-        # heading (compass fused with the gyro, Eq. 6.12) and its slice
-        wl, wh = _mul(dtl, dth, float(rec.yaw_rate[0]), float(rec.yaw_rate[1]))
-        h0l, h0h = self.heading_lo, self.heading_hi
-        hl, hh = max(float(rec.heading[0]), _dn(h0l + wl)), min(float(rec.heading[1]), _up(h0h + wh))
-        zl, zh = min(wl, 0.0), max(wh, 0.0)
-        sl, sh = max(_dn(h0l + zl), _dn(hl - zh)), min(_up(h0h + zh), _up(hh - zl))
-        if not (hl <= hh and sl <= sh):
+        lo, hi = self.pose_lo, self.pose_hi
+        h, y, v = rec.heading, rec.yaw_rate, rec.speed
+        ok, hl, hh, x0, y0, x1, y1, *d = predict(lo[0], lo[1], hi[0], hi[1], self.heading_lo, self.heading_hi,
+                                                 float(rec.t) - float(self._prev.t), y[0], y[1], h[0], h[1],
+                                                 v[0], v[1])  # fmt: skip
+        if not ok:
             return self._fail(start)
-        # position (Eq. 6.23): x_k = x_{k-1} + [dt]·[v]·(cos, sin)[ψ]
-        cl, ch, snl, snh = _cos_sin(sl, sh)
-        vl, vh = float(rec.speed[0]), float(rec.speed[1])
-        d = [_mul(dtl, dth, *_mul(vl, vh, cl, ch)), _mul(dtl, dth, *_mul(vl, vh, snl, snh))]
-        lo = np.array([_dn(float(self.pose_lo[i]) + d[i][0]) for i in (0, 1)])
-        hi = np.array([_up(float(self.pose_hi[i]) + d[i][1]) for i in (0, 1)])
+        lo, hi = np.array([x0, y0]), np.array([x1, y1])
         self.heading_lo, self.heading_hi = hl, hh
         if self.config.impacts:
             lo, hi = self.dig.contract_box(lo, hi, self._impact_bound(rec))
-        if not np.all(lo <= hi):
+        if not (lo[0] <= hi[0] and lo[1] <= hi[1]):
             return self._fail(start)
         self.pose_lo, self.pose_hi = lo, hi
-        self._measure(rec, np.array([d[0][0], d[1][0], d[0][1], d[1][1]]))
+        self._measure(rec, np.array(d))
         if self.config.smoothing_window and not self._smooth():
             return self._fail(start)
         self.last_update_seconds = time.perf_counter() - start
@@ -215,7 +182,7 @@ class OnlineDigSlam:
     @staticmethod
     def _impact_bound(rec: MissionRecord) -> float:
         """Smallest upper range bound over the echoing sensors (``inf`` if none echoed)."""
-        return float(np.min(np.where(rec.no_echo, _INF, rec.range[:, 1]), initial=_INF))
+        return impact_bound(rec.no_echo, rec.range)
 
     def _fail(self, start: float) -> None:
         self.consistent, self.inconsistent_step = False, self.steps
@@ -224,30 +191,23 @@ class OnlineDigSlam:
         self.steps += 1
         self.last_update_seconds = time.perf_counter() - start
 
-    def _dig(self, rec: MissionRecord, lo: np.ndarray, hi: np.ndarray, psi: tuple[float, float]) -> None:
-        """Eq. 6.21 for the readings of one step; the dug cells are certainly sensed (radius ``<= r_max``)."""
-        r = np.minimum(rec.range[:, 0], rec.r_max)
-        ok = np.isfinite(r) & (r > 0)
-        omni = ok & (rec.gamma >= rnd.PI_DOWN)
-        cone = ok & ~omni
-        if omni.any():
-            n = int(omni.sum())
-            self.dig.dig_disks(np.tile(lo, (n, 1)), np.tile(hi, (n, 1)), r[omni])
-        if cone.any():
-            n = int(cone.sum())
-            self.dig.dig_sectors(np.tile(lo, (n, 1)), np.tile(hi, (n, 1)), np.full(n, psi[0]),
-                                 np.full(n, psi[1]), rec.alpha[cone], rec.gamma[cone], r[cone])  # fmt: skip
-        reach = float(np.max(rec.r_max))
-        r0, r1, c0, c1 = self.dig.win(lo - reach, hi + reach)
-        self.sensed_sure[r0:r1, c0:c1] |= self.dig.free[r0:r1, c0:c1]
+    def _dig(self, rec: MissionRecord, lo: np.ndarray, hi: np.ndarray, psi: tuple[float, float],
+             mark: bool = False) -> None:  # fmt: skip
+        """Eq. 6.21 for the readings of one step (the dug cells are certainly sensed: radius ``<= r_max``);
+        with ``mark``, grow the possibly sensed zone with the upper ranges (:mod:`.online_jit`)."""
+        d = self.dig
+        r0, r1, c0, c1 = dig_and_mark(d.free, self.sensed_sure, self.sensed_maybe, d.xs, d.ys, d.nys, lo[0],
+                                      lo[1], hi[0], hi[1], psi[0], psi[1], rec.alpha, rec.gamma, rec.r_max,
+                                      rec.range, mark)  # fmt: skip
+        t0, t1, u0, u1 = self.touched
+        if r0 < r1 and c0 < c1:  # the window holding every changed cell
+            t = (min(t0, r0), max(t1, r1), min(u0, c0), max(u1, c1))
+            self.touched = (r0, r1, c0, c1) if t0 >= t1 else t
 
     def _measure(self, rec: MissionRecord, d: np.ndarray | None) -> None:
         """Dig the readings of the current step and grow the possibly sensed zone; push the step."""
         psi = (self.heading_lo, self.heading_hi)
-        self._dig(rec, self.pose_lo, self.pose_hi, psi)
-        r_plus = np.minimum(rec.range[:, 1], rec.r_max)
-        mark_possibly_sensed(self.grid, self.sensed_maybe, self.pose_lo, self.pose_hi, psi[0], psi[1],
-                             rec.alpha, rec.gamma, r_plus)  # fmt: skip
+        self._dig(rec, self.pose_lo, self.pose_hi, psi, mark=True)
         if self.config.smoothing_window:
             self._ring.append([rec, self.pose_lo.copy(), self.pose_hi.copy(), psi, d])
         self._prev = rec
@@ -270,6 +230,12 @@ class OnlineDigSlam:
         return True
 
     # ------------------------------------------------------------------ outputs
+    def take_touched(self) -> tuple[int, int, int, int]:
+        """Rows ``r0:r1`` and columns ``c0:c1`` holding every cell of ``dig.free``, ``sensed_sure`` and
+        ``sensed_maybe`` changed since the last call (the whole grid after ``reset``); then clears it."""
+        out, self.touched = self.touched, (0, 0, 0, 0)
+        return out
+
     def explored(self) -> np.ndarray:
         """``(ny, nx)`` int8: CLEAR (certainly sensed), PENUMBRA (possibly), DARK (certainly not)."""
         out = np.full(self.grid.shape, DARK, dtype=np.int8)

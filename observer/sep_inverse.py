@@ -2,7 +2,9 @@
 
 One forward pass evaluates ``f`` on the batch; backward passes then project ``Y`` (for ``x_out``)
 and the closed complement of ``Y`` (for ``x_in``) back onto the boxes. ``Y`` is an interval, a box,
-or any separator in the image space.
+or any separator in the image space. When ``f`` has a :class:`~.jit_tape.Tape` (no trigonometric,
+``min``/``max`` or ``atan2`` node) the whole batch is separated by compiled kernels
+(:mod:`.jit_hc4`); otherwise by the numpy forward-backward of :mod:`.contractors`.
 
 >>> ring = SepInverse(Function(lambda x: (x[0] - 2) ** 2 + (x[1] - 2.5) ** 2), Interval(1, 2.25))
 >>> xin, xout = ring(Box([(3.1, 3.2), (2.4, 2.6)]))        # inside the ring of Ex. 2.7
@@ -19,6 +21,8 @@ import numpy as np
 from .boxes import chunked
 from .contractors import hc4_backward
 from .expr import Function
+from .jit_hc4 import hc4, image, sep_box
+from .jit_tape import Tape
 from .separators import Batch, Sep, SepBox, hull_batch
 
 
@@ -45,6 +49,7 @@ class SepInverse(Sep):
             if box.n != self.f.m:
                 raise ValueError(f"y: box of dimension {box.n}, but f has {self.f.m} outputs")
             self.sep_y, self.box = None, box
+            self._y = np.stack(box.box).astype(np.float64)
 
     def image(self, vals: list[tuple[np.ndarray, np.ndarray]], n_rows: int) -> Batch:
         """The forward image ``[f]([x])`` as an ``(N, m)`` batch."""
@@ -54,7 +59,20 @@ class SepInverse(Sep):
         return ylo, yhi
 
     def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
-        return chunked(self._separate, lo, hi)
+        tape = Tape.of(self.f)
+        if tape is None:
+            return chunked(self._separate, lo, hi)
+        if self.box is not None:
+            res = sep_box(tape, lo, hi, self._y)
+            return (res[0], res[1]), (res[2], res[3])
+        yin, yout = self.sep_y.separate(*image(tape, lo, hi))
+        return hc4(tape, lo, hi, *yin), hc4(tape, lo, hi, *yout)
+
+    def separate_stacked(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        tape = Tape.of(self.f)
+        if tape is not None and self.box is not None:
+            return sep_box(tape, lo, hi, self._y)
+        return super().separate_stacked(lo, hi)
 
     def _separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
         vals = self.f.forward(lo, hi)

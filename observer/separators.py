@@ -21,6 +21,7 @@ import numpy as np
 
 from .boxes import empty_rows, normalize_empty, validate_batch
 from .interval import IntervalArray, as_pair
+from .jit import njit
 
 Batch = tuple[np.ndarray, np.ndarray]
 
@@ -34,6 +35,15 @@ class Sep:
     def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
         """Return ``((in_lo, in_hi), (out_lo, out_hi))``; inputs are not modified."""
         raise NotImplementedError(f"{type(self).__name__}.separate")
+
+    def separate_stacked(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        """:meth:`separate` as one ``(4, N, n)`` array ``in_lo, in_hi, out_lo, out_hi`` (what the paver
+        and the algebra pass around; compiled separators produce it directly)."""
+        (ilo, ihi), (olo, ohi) = self.separate(lo, hi)
+        shape = (4, *np.shape(lo))
+        res = np.empty(shape)
+        res[0], res[1], res[2], res[3] = ilo, ihi, olo, ohi
+        return res
 
     def __call__(self, boxes: IntervalArray | tuple[Any, Any]) -> tuple[Any, Any]:
         """Separate an :class:`IntervalArray` box ``(n,)`` / batch ``(N, n)``, or a ``(lo, hi)`` pair."""
@@ -79,44 +89,79 @@ def hull_batch(a: Batch, b: Batch) -> Batch:
     return np.minimum(a[0], b[0]), np.maximum(a[1], b[1])
 
 
-class SepNot(Sep):
+@njit
+def _fold(acc: np.ndarray, s: np.ndarray, lo: np.ndarray, hi: np.ndarray, union: bool) -> np.ndarray:
+    """Fold one separated batch ``s (4, N, n)`` into ``acc`` by Eq. 2.54 (a new ``acc`` when it is
+    ``(0, 0, 0)``): for ``&``, ``x_in ⊔= s_in`` and ``x_out ∩= s_out``; for ``|`` the other way round.
+    The intersections are also met with ``[x]``; empty rows come out as ``[+inf, -inf]``."""
+    nb, n = lo.shape
+    h, m = (2, 0) if union else (0, 2)  # the part taking the hull, the part taking the meet
+    if acc.shape[0] == 0:
+        acc = np.empty((4, nb, n))
+        acc[h], acc[h + 1] = np.inf, -np.inf
+        acc[m], acc[m + 1] = lo, hi
+    for r in range(nb):
+        empty = False
+        for i in range(n):
+            empty |= s[h, r, i] > s[h + 1, r, i]
+        if not empty:
+            for i in range(n):
+                acc[h, r, i] = min(acc[h, r, i], s[h, r, i])
+                acc[h + 1, r, i] = max(acc[h + 1, r, i], s[h + 1, r, i])
+        empty = False
+        for i in range(n):
+            acc[m, r, i] = max(acc[m, r, i], s[m, r, i], lo[r, i])
+            acc[m + 1, r, i] = min(acc[m + 1, r, i], s[m + 1, r, i], hi[r, i])
+            empty |= acc[m, r, i] > acc[m + 1, r, i]
+        if empty:
+            acc[m, r], acc[m + 1, r] = np.inf, -np.inf
+    return acc
+
+
+_NONE = np.empty((0, 0, 0))
+
+
+class _Stacked(Sep):
+    """A separator computed on stacked ``(4, N, n)`` arrays; :meth:`separate` unpacks them."""
+
+    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        res = self.separate_stacked(lo, hi)
+        return (res[0], res[1]), (res[2], res[3])
+
+
+class SepNot(_Stacked):
     """Complement ``{S_out, S_in}`` (Eq. 2.53)."""
 
     def __init__(self, sep: Sep) -> None:
         self.sep, self.n = sep, sep.n
 
-    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
-        xin, xout = self.sep.separate(lo, hi)
-        return xout, xin
+    def separate_stacked(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        return self.sep.separate_stacked(lo, hi)[[2, 3, 0, 1]]
 
     def __invert__(self) -> Sep:
         return self.sep
 
 
-class SepInter(Sep):
+class SepInter(_Stacked):
     """``S₁ ∩ … ∩ S_k = {⊔ S_iⁱⁿ, ∩ S_iᵒᵘᵗ}`` (Eq. 2.54)."""
 
+    union = False
+
     def __init__(self, *seps: Sep) -> None:
         self.seps, self.n = seps, _dim(seps)
 
-    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
-        xin = (np.full_like(lo, np.inf), np.full_like(hi, -np.inf))
-        xout = (lo, hi)
+    def separate_stacked(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        lo, hi = np.ascontiguousarray(lo, dtype=np.float64), np.ascontiguousarray(hi, dtype=np.float64)
+        acc = _NONE
         for s in self.seps:
-            i, o = s.separate(lo, hi)
-            xin, xout = hull_batch(xin, normalize_empty(*i)), inter_batch(xout, o)
-        return xin, xout
+            acc = _fold(acc, np.ascontiguousarray(s.separate_stacked(lo, hi)), lo, hi, self.union)
+        return acc
 
 
-class SepUnion(Sep):
+class SepUnion(SepInter):
     """``S₁ ∪ … ∪ S_k = {∩ S_iⁱⁿ, ⊔ S_iᵒᵘᵗ}`` (Eq. 2.54)."""
 
-    def __init__(self, *seps: Sep) -> None:
-        self.seps, self.n = seps, _dim(seps)
-
-    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
-        xin, xout = SepInter(*(SepNot(s) for s in self.seps)).separate(lo, hi)
-        return xout, xin
+    union = True
 
 
 def relaxed_intersection(los: np.ndarray, his: np.ndarray, q: int) -> Batch:
