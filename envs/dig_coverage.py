@@ -74,18 +74,15 @@ class DigCoverageEnv(GuaranteedObserver):
         self._render_mode = render_mode
         self._bg: np.ndarray | None = None
         self._bg_world: Any = None
+        self._extra_info = {"target": cfg.target}  # info["target"], added by the wrapper's info
 
     @property
     def render_mode(self) -> str | None:  # type: ignore[override]
         return self._render_mode
 
-    def reset(self, **kwargs: Any) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
-        obs, info = super().reset(**kwargs)
-        return obs, self._info(info)
-
     def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         obs, _, _, truncated, info = super().step(action)
-        return obs, self._reward(info), self._terminated(info), truncated, self._info(info)
+        return obs, self._reward(info), self._terminated(info), truncated, info
 
     # --- pieces of step ------------------------------------------------------------------------------------
     def _reward(self, info: dict[str, Any]) -> float:
@@ -96,10 +93,6 @@ class DigCoverageEnv(GuaranteedObserver):
 
     def _terminated(self, info: dict[str, Any]) -> bool:
         return bool(info["consistent"] and info["certified_coverage"] >= self.config.target)
-
-    def _info(self, info: dict[str, Any]) -> dict[str, Any]:
-        info["target"] = self.config.target
-        return info
 
     # --- rendering -----------------------------------------------------------------------------------------
     def render(self) -> np.ndarray | None:  # type: ignore[override]

@@ -102,6 +102,10 @@ class ExploreEnv(gym.Env):
         self._odo_tops = (float(self._odo_top[0, 0]), float(self._odo_top[1, 0]))
         hb = self.observation_space["heading"]
         self._heading_box = (float(hb.low[0]), float(hb.high[0]))
+        #: Build the raw observation in :meth:`step` (default True). The observer wrapper, which hands its
+        #: own observation to the agent and never reads this one, sets it False: ``step`` then returns None
+        #: as its observation and everything else unchanged (``reset`` always builds it).
+        self.raw_observation = True
         self.world: World | None = None
         self.sim: RobotSim | None = None
         self.coverage: Coverage | None = None
@@ -148,7 +152,8 @@ class ExploreEnv(gym.Env):
         reward = self._reward(truth)
         if self.render_mode == "human":
             self.render()
-        return self._obs(record), reward, self._terminated(), False, self._info(record, truth)
+        obs = self._obs(record) if self.raw_observation else None
+        return obs, reward, self._terminated(), False, self._info(record, truth)
 
     def render(self) -> np.ndarray | None:
         if self.render_mode is None:

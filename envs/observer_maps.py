@@ -11,7 +11,8 @@ covers cells ``starts[p] <= c < starts[p + 1]`` with ``starts[p] = floor(p n / m
 The per-cell work is compiled (``digslam.observer.jit.njit``): :func:`observer_sets` turns the filter's
 certainly / possibly sensed and dug cells into the explored codes, the clear and dark masks and the
 certified count in one pass, and :func:`sets_and_map` keeps them and the image up to date on the window
-of cells a step changed.
+of cells a step changed; :func:`observe` does that, then the pose-box channel, the ``"state"`` vector and
+the copies ``info`` hands out, all in one compiled call per step (the wrapper's fast path).
 
 >>> clear = np.zeros((4, 4), bool); clear[:2, :2] = True; clear[0, 2] = True
 >>> dark = np.zeros((4, 4), bool); dark[2:, 2:] = True
@@ -22,12 +23,14 @@ of cells a step changed.
 
 from __future__ import annotations
 
+import math
 from bisect import bisect_left, bisect_right
 from functools import lru_cache
 
 import numpy as np
 
 from digslam.observer.jit import njit
+from digslam.observer.online_jit import window
 from digslam.observer.thick_sep import CLEAR, DARK, PENUMBRA
 
 _CLEAR, _PENUMBRA, _DARK = int(CLEAR), int(PENUMBRA), int(DARK)
@@ -133,6 +136,118 @@ def _sets_and_map(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, reach: 
     n = _sets(sure, maybe, free, reach, explored, clear, dark, r0, r1, c0, c1)
     _fill(clear.view(np.uint8), dark.view(np.uint8), img, 0, rs, re, cs, ce, p0, p1, q0, q1)
     return n
+
+
+@njit
+def _right(s: np.ndarray, v: int) -> int:
+    """``bisect_right(s, v)`` on the increasing int array ``s``."""
+    lo, hi = 0, s.size
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if s[mid] <= v:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+@njit
+def _pixels(s: np.ndarray, r0: int, r1: int, n: int) -> tuple[int, int]:
+    """:func:`pixel_range` on the block starts ``s`` (compiled twin, same result)."""
+    if r0 >= r1:
+        return 0, 0
+    m = s.size
+    p0 = _right(s, r0) - 1
+    p1 = _right(s, r1 - 1)
+    if n < m:  # several pixels share a cell: take them all (bisect_left(s, s[p0]))
+        v = s[p0]
+        lo, hi = 0, m
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if s[mid] < v:
+                lo = mid + 1
+            else:
+                hi = mid
+        p0 = lo
+    return max(p0, 0), min(p1, m)
+
+
+@njit
+def _observe(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, planes: np.ndarray, base: np.ndarray,
+             img: np.ndarray, blocks: np.ndarray, r0: int, r1: int, c0: int, c1: int, xs: np.ndarray,
+             nys: np.ndarray, lo: np.ndarray, hi: np.ndarray, h0: float, h1: float, norm: np.ndarray,
+             steps: int, n_reach: int, n_prev: int, state: np.ndarray, snap: np.ndarray) -> int:  # fmt: skip
+    """:func:`observe` (``planes`` ``(4, ny, nx)`` uint8: explored, clear, dark, reach; ``blocks``
+    ``(4, m)``: the pixel block bounds ``rs, re, cs, ce`` of :func:`_bounds`)."""
+    ny, nx = sure.shape
+    explored, clear, dark, reach = planes[0], planes[1], planes[2], planes[3]
+    rs, re, cs, ce = blocks[0], blocks[1], blocks[2], blocks[3]
+    p0, p1 = _pixels(rs, r0, r1, ny)
+    q0, q1 = _pixels(cs, c0, c1, nx)
+    n = n_prev + _sets(sure, maybe, free, reach, explored, clear, dark, r0, r1, c0, c1)
+    _fill(clear, dark, base, 0, rs, re, cs, ce, p0, p1, q0, q1)
+    e8, c8, s8 = explored.reshape(-1), clear.reshape(-1), snap.reshape(-1)
+    f8 = free.view(np.uint8).reshape(-1)
+    k = e8.size
+    for i in range(k):  # the snapshot: explored, clear, free
+        s8[i] = e8[i]
+    for i in range(k):
+        s8[k + i] = c8[i]
+    for i in range(k):
+        s8[2 * k + i] = f8[i]
+    b8, o8 = base.reshape(-1), img.reshape(-1)  # flat loops (C-contiguous): they vectorize
+    k = b8.size
+    for i in range(k):
+        o8[i] = b8[i]
+    for i in range(k, k + k // 3):
+        o8[i] = 0
+    x0, y0, x1, y1 = lo[0], lo[1], hi[0], hi[1]
+    f0, f1, g0, g1 = window(xs, nys, x0, y0, x1, y1)
+    p0, p1 = _pixels(rs, f0, f1, ny)
+    q0, q1 = _pixels(cs, g0, g1, nx)
+    full = np.uint8(255)
+    for p in range(p0, p1):
+        row = img[3, p]
+        for q in range(q0, q1):
+            row[q] = full
+    cx, cy, hx, hy = norm[0], norm[1], norm[2], norm[3]
+    hm, hw = 0.5 * (h0 + h1), 0.5 * (h1 - h0)
+    state[0] = min(max((x0 - cx) / hx, -1.0), 1.0)
+    state[1] = min(max((y0 - cy) / hy, -1.0), 1.0)
+    state[2] = min(max((x1 - cx) / hx, -1.0), 1.0)
+    state[3] = min(max((y1 - cy) / hy, -1.0), 1.0)
+    state[4], state[5] = math.cos(hm), math.sin(hm)
+    state[6] = min(hw / math.pi, 1.0)
+    state[7] = math.tanh(max(x1 - x0, y1 - y0))
+    state[8] = min(steps / norm[4], 1.0)
+    state[9] = n / n_reach
+    state[10] = 1.0
+    return n
+
+
+def observe(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, planes: np.ndarray, base: np.ndarray,
+            img: np.ndarray, window: tuple[int, int, int, int], xs: np.ndarray, nys: np.ndarray,
+            lo: np.ndarray, hi: np.ndarray, heading: tuple[float, float], norm: np.ndarray, steps: int,
+            n_reach: int, n_prev: int, state: np.ndarray, snap: np.ndarray) -> int:  # fmt: skip
+    """One step of the wrapper's observation in one compiled call: :func:`sets_and_map` of ``window`` into
+    the sets and ``base`` (the clear / penumbra / dark channels), then ``img[:3] = base``, ``img[3]`` the
+    pose-box footprint (the pixels whose blocks meet the cells of the box ``lo, hi``,
+    :func:`.online_jit.window`) and the 11 values of ``state`` (the wrapper's ``"state"``).
+
+    ``planes`` is ``(4, ny, nx)`` uint8: the explored codes (int8 bytes), the clear and dark masks and the
+    reachable free cells (0 / 1); ``norm`` is ``(cx, cy, hx, hy, horizon)`` (grid centre and half-sides);
+    ``steps`` the elapsed steps, ``n_reach`` the reachable free cells and ``n_prev`` the certified count
+    before the step; ``snap`` ``(3, ny, nx)`` uint8 receives copies of the explored codes, the clear mask and
+    ``free``. Returns the new count. No argument checks: the wrapper's own arrays.
+    """
+    blocks = pixel_blocks(sure.shape, img.shape[-1])
+    return int(_observe(sure, maybe, free, planes, base, img, blocks, *window, xs, nys, lo, hi, heading[0],
+                        heading[1], norm, steps, n_reach, n_prev, state, snap))  # fmt: skip
+
+
+def pixel_blocks(shape: tuple[int, int], m: int) -> np.ndarray:
+    """``(4, m)`` int64: block bounds ``rs, re`` of the rows, ``cs, ce`` of the columns (:func:`_bounds`)."""
+    return np.array([*_bounds(shape[0], m)[:2], *_bounds(shape[1], m)[:2]], dtype=np.int64)
 
 
 def _check_sets(arrays: tuple[np.ndarray, ...]) -> None:

@@ -48,7 +48,7 @@ from digslam.observer.thick_sep import PENUMBRA
 
 from .monitor import GuaranteeMonitor
 from .observer_config import ObserverConfig
-from .observer_maps import crop_window, fill_map, pixel_range, sets_and_map
+from .observer_maps import _observe, crop_window, fill_map, pixel_blocks
 from .raster import FREE, rasterize
 from .world import World
 
@@ -98,6 +98,9 @@ class GuaranteedObserver(gym.Wrapper):
         env: an :class:`~digslam.envs.explore_env.ExploreEnv` (possibly wrapped).
         grid_cell, map_size, crop, monitor: override the fields of ``config``.
         config: an :class:`ObserverConfig`, a mapping, or an ``OnlineConfig`` (filter settings only).
+
+    When ``env`` is the raw env itself (no wrapper between), its ``raw_observation`` is switched off: the
+    agent sees this wrapper's observation only, so the raw one is not built on each step.
     """
 
     def __init__(
@@ -127,19 +130,26 @@ class GuaranteedObserver(gym.Wrapper):
             }
         )
         self.filter = OnlineDigSlam(self.grid, cfg.online)
+        if env is raw:  # nothing between reads the raw observation, which this wrapper replaces
+            raw.raw_observation = False
+        self._extra_info: dict[str, Any] = {}  # constant keys added to every info (subclasses)
         g = self.grid
         self.cell_area = g.cell_size[0] * g.cell_size[1]
         self._centre = 0.5 * (np.array(g.lo) + np.array(g.hi))
         self._half = 0.5 * (np.array(g.hi) - np.array(g.lo))
-        self._centre_half = (tuple(self._centre.tolist()), tuple(self._half.tolist()))
+        self._norm = np.array([*self._centre, *self._half, cfg.horizon], dtype=np.float64)  # for _observe
+        self._blocks = pixel_blocks(g.shape, cfg.map_size)
+        self._obs: tuple[np.ndarray, np.ndarray] = (np.zeros(0, np.uint8), np.zeros(0, np.float32))
         self._reach_world: Any = None
         self.reachable = np.zeros(g.shape, dtype=bool)
         self.monitor: GuaranteeMonitor | None = None
         self.steps, self._cache_step = 0, -1
         self._cache: tuple[np.ndarray, np.ndarray, np.ndarray, int] = (np.zeros(0),) * 3 + (0,)
+        self._dig_copy = np.zeros(0, bool)
         m, shape = cfg.map_size, g.shape
-        self._explored_all, self._clear_all = np.empty(shape, np.int8), np.zeros(shape, bool)
-        self._dark_all, self._base, self._n = np.empty(shape, bool), np.zeros((3, m, m), np.uint8), 0
+        self._planes = np.zeros((4, *shape), np.uint8)  # explored (int8), clear, dark, reachable: observe()
+        self._explored_all, self._clear_all = self._planes[0].view(np.int8), self._planes[1].view(np.bool_)
+        self._dark_all, self._base, self._n = self._planes[2].view(np.bool_), np.zeros((3, m, m), np.uint8), 0
 
     # --- gymnasium API -------------------------------------------------------------------------------------
     def reset(self, **kwargs: Any) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
@@ -150,6 +160,7 @@ class GuaranteedObserver(gym.Wrapper):
         if self._reach_world is not raw.world or not self._in_reach(truth.pose):  # once per world and start
             self.reachable = reachable_free(raw.world, self.grid, truth.pose)
             self.n_reachable = max(int(np.count_nonzero(self.reachable)), 1)
+            self._planes[3] = self.reachable
             self._reach_world = raw.world
         b = self.obs_config.start_box
         p = truth.pose[:2]
@@ -164,8 +175,10 @@ class GuaranteedObserver(gym.Wrapper):
 
     def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         _, reward, terminated, truncated, info = self.env.step(action)
-        self._feed(info["record"])
-        self._check(info)
+        self.filter.update(info["record"])  # :meth:`_feed`, inlined
+        self.steps += 1
+        if self.monitor is not None:
+            self.monitor.check(self.filter, info["truth"], info["record"], self.steps)
         truncated = truncated or not self.filter.consistent
         return self.observation(), float(reward), terminated, truncated, self._obs_info(info)
 
@@ -191,20 +204,41 @@ class GuaranteedObserver(gym.Wrapper):
 
     def _sets(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
         """The filter's explored codes, clear and dark masks and certified cell count, once per step, with
-        the map's clear / penumbra / dark channels. Kept up to date on the cells the step touched
-        (:meth:`OnlineDigSlam.take_touched`); ``info`` gets copies."""
+        the observation (:meth:`observation`): one compiled call (the kernel of
+        :func:`.observer_maps.observe`) keeps the sets and the map's clear / penumbra / dark channels up to
+        date on the cells the step touched (:meth:`OnlineDigSlam.take_touched`) and draws the pose-box channel
+        and the state; ``info`` gets copies of the sets."""
         if self._cache_step != self.steps:
             f, (ny, nx) = self.filter, self.grid.shape
             win = f.take_touched()
             if win == (0, ny, 0, nx):  # after a reset: everything (and the reachable area may be new)
                 self._clear_all[:] = False
                 self._n = 0
-            self._n += sets_and_map(f.sensed_sure, f.sensed_maybe, f.dig.free, self.reachable,
-                                    self._explored_all, self._clear_all, self._dark_all, self._base,
-                                    win)  # fmt: skip
-            self._cache = (self._explored_all.copy(), self._clear_all.copy(), self._dark_all, self._n)
+            m = self.obs_config.map_size
+            img, state = np.empty((self.n_channels, m, m), np.uint8), np.empty(N_STATE, dtype=np.float32)
+            d, snap = f.dig, np.empty((3, ny, nx), np.uint8)  # info's explored, clear and dig
+            self._n = int(_observe(f.sensed_sure, f.sensed_maybe, d.free, self._planes, self._base, img,
+                                   self._blocks, *win, d.xs, d.nys, f.pose_lo, f.pose_hi, f.heading_lo,
+                                   f.heading_hi, self._norm, self.steps, self.n_reachable, self._n, state,
+                                   snap))  # fmt: skip
+            if self.obs_config.crop is not None:
+                self._crop(img)
+            self._obs = (img, state)
+            self._cache = (snap[0].view(np.int8), snap[1].view(np.bool_), self._dark_all, self._n)
+            self._dig_copy = snap[2].view(np.bool_)
             self._cache_step = self.steps
         return self._cache
+
+    def _crop(self, img: np.ndarray) -> None:
+        """Channels 4-6: clear / penumbra / dark of the ``crop`` window centred on the pose box."""
+        f, g = self.filter, self.grid
+        k = max(int(math.ceil(self.obs_config.crop / g.cell_size[0])), 1)
+        ctr = 0.5 * (f.pose_lo + f.pose_hi)
+        rc = int(Grid.count_below(-g.ys, np.array([-ctr[1]]))[0]) - 1
+        cc = int(Grid.count_below(g.xs, np.array([ctr[0]]))[0]) - 1
+        a, b = rc - k // 2, cc - k // 2
+        clear, dark = crop_window(self._clear_all, a, b, k, False), crop_window(self._dark_all, a, b, k, True)
+        fill_map(clear, dark, img, 4)
 
     def _certified_count(self) -> int:
         """Clear cells in the reachable free area (0 once the claims are withdrawn)."""
@@ -212,56 +246,29 @@ class GuaranteedObserver(gym.Wrapper):
 
     def observation(self) -> dict[str, np.ndarray]:
         """The ``"map"`` and ``"state"`` of the filter's current sets (serves reset and step)."""
-        f, m, g = self.filter, self.obs_config.map_size, self.grid
-        state = np.zeros(N_STATE, dtype=np.float32)
-        if not f.consistent:  # claims withdrawn: everything is penumbra
+        if not self.filter.consistent:  # claims withdrawn: everything is penumbra
+            m = self.obs_config.map_size
             img = np.zeros((self.n_channels, m, m), dtype=np.uint8)
             img[1] = 255
-            return {"map": img, "state": state}
-        _, clear, dark, n = self._sets()
-        img = np.zeros((self.n_channels, m, m), dtype=np.uint8)
-        img[:3] = self._base
-        lo, hi = f.pose_lo, f.pose_hi
-        r0, r1, c0, c1 = f.dig.win(lo, hi)
-        p0, p1 = pixel_range(r0, r1, g.shape[0], m)
-        q0, q1 = pixel_range(c0, c1, g.shape[1], m)
-        img[3, p0:p1, q0:q1] = 255
-        crop = self.obs_config.crop
-        if crop is not None:
-            k = max(int(math.ceil(crop / g.cell_size[0])), 1)
-            ctr = 0.5 * (lo + hi)
-            rc = int(Grid.count_below(-g.ys, np.array([-ctr[1]]))[0]) - 1
-            cc = int(Grid.count_below(g.xs, np.array([ctr[0]]))[0]) - 1
-            a, b = rc - k // 2, cc - k // 2
-            fill_map(crop_window(clear, a, b, k, False), crop_window(dark, a, b, k, True), img, 4)
-        (x0, y0), (x1, y1) = lo.tolist(), hi.tolist()
-        (cx, cy), (hx, hy) = self._centre_half
-        h0, h1 = float(f.heading_lo), float(f.heading_hi)
-        hm, hw = 0.5 * (h0 + h1), 0.5 * (h1 - h0)
-        state[:] = (min(max((x0 - cx) / hx, -1.0), 1.0), min(max((y0 - cy) / hy, -1.0), 1.0),
-                    min(max((x1 - cx) / hx, -1.0), 1.0), min(max((y1 - cy) / hy, -1.0), 1.0),
-                    math.cos(hm), math.sin(hm), min(hw / math.pi, 1.0), math.tanh(max(x1 - x0, y1 - y0)),
-                    min(self.steps / self.obs_config.horizon, 1.0), n / self.n_reachable, 1.0)  # fmt: skip
+            return {"map": img, "state": np.zeros(N_STATE, dtype=np.float32)}
+        self._sets()
+        img, state = self._obs
         return {"map": img, "state": state}
 
     def _obs_info(self, info: dict[str, Any]) -> dict[str, Any]:
         f = self.filter
-        out = dict(info)
-        ok = bool(f.consistent)
-        if ok:
+        if f.consistent:
             explored, clear, _, n = self._sets()
-        else:
-            explored, clear, n = np.full(self.grid.shape, PENUMBRA), np.zeros(self.grid.shape, bool), 0
-        out.update(
-            explored=explored,
-            dig=f.dig.free.copy() if ok else np.zeros(self.grid.shape, dtype=bool),
-            clear=clear,
-            pose_box=np.array([f.pose_lo.tolist(), f.pose_hi.tolist()]) if ok else np.full((2, 2), np.nan),
-            heading_box=np.array([f.heading_lo, f.heading_hi], np.float64) if ok else np.full(2, np.nan),
-            certified_coverage=n / self.n_reachable,
-            clear_area=n * self.cell_area,
-            true_coverage=float(info.get("coverage", 0.0)),
-            consistent=ok,
-            inconsistent_step=f.inconsistent_step,
-        )
-        return out
+            return {**info, "explored": explored, "dig": self._dig_copy, "clear": clear,
+                    "pose_box": np.array((f.pose_lo, f.pose_hi), np.float64),
+                    "heading_box": np.array((f.heading_lo, f.heading_hi), np.float64),
+                    "certified_coverage": n / self.n_reachable, "clear_area": n * self.cell_area,
+                    "true_coverage": float(info.get("coverage", 0.0)), "consistent": True,
+                    "inconsistent_step": f.inconsistent_step, **self._extra_info}  # fmt: skip
+        shape = self.grid.shape
+        return {**info, "explored": np.full(shape, PENUMBRA), "dig": np.zeros(shape, dtype=bool),
+                "clear": np.zeros(shape, bool), "pose_box": np.full((2, 2), np.nan),
+                "heading_box": np.full(2, np.nan), "certified_coverage": 0 / self.n_reachable,
+                "clear_area": 0 * self.cell_area, "true_coverage": float(info.get("coverage", 0.0)),
+                "consistent": False, "inconsistent_step": f.inconsistent_step,
+                **self._extra_info}  # fmt: skip

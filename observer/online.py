@@ -16,6 +16,9 @@ Each :meth:`OnlineDigSlam.update` takes the next single-step record and
 4. optionally (``smoothing_window = W``) contracts the last ``W`` boxes backward,
    ``x_j &= x_{j+1} - [d_j]``, and digs again the readings of the boxes that shrank.
 
+Steps 1–3 run as one compiled call (:func:`.online_jit_step.filter_step`, the same kernels chained), and
+:attr:`OnlineDigSlam.touched` grows by the smallest window holding the cells the step changed.
+
 State is a fixed set of arrays (plus a ring of ``W`` steps): memory does not grow with the episode.
 An empty box means the data contradict their bounds: the filter says so and stops (never a false claim).
 
@@ -47,7 +50,8 @@ from .grid import Grid
 from .online_explored import WindowDigMap
 from .online_jit_mark import dig_and_mark
 from .online_jit_pose import cos_sin as _cos_sin  # noqa: F401  (re-exported: the tests use it)
-from .online_jit_pose import impact_bound, predict
+from .online_jit_pose import impact_bound
+from .online_jit_step import filter_step
 from .record import MissionRecord
 from .thick_sep import CLEAR, DARK, PENUMBRA
 
@@ -110,6 +114,7 @@ class OnlineDigSlam:
             raise ValueError(f"config: expected an OnlineConfig, got {type(config).__name__}")
         self.grid, self.config = grid, config or OnlineConfig()
         self._ring: deque = deque(maxlen=self.config.smoothing_window + 1)
+        self._impacts = bool(self.config.impacts)
         self._blank()
 
     def _blank(self) -> None:
@@ -127,12 +132,13 @@ class OnlineDigSlam:
     def _check_record(self, rec: Any, name: str = "rec") -> MissionRecord:
         if not isinstance(rec, MissionRecord) or rec.t.ndim != 0:
             raise ValueError(f"{name}: expected a single-step MissionRecord (scalar t)")
-        if name == "rec" and self._prev is not None:
-            if rec.n_sensors != self._prev.n_sensors:
-                n = self._prev.n_sensors
+        prev = self._prev
+        if name == "rec" and prev is not None:
+            if rec.alpha.shape[-1] != prev.alpha.shape[-1]:  # n_sensors
+                n = prev.n_sensors
                 raise ValueError(f"{name}: {rec.n_sensors} sensors, the episode started with {n}")
-            if not float(rec.t) > float(self._prev.t):
-                raise ValueError(f"{name}: time {float(rec.t)} does not follow {float(self._prev.t)}")
+            if not float(rec.t) > float(prev.t):
+                raise ValueError(f"{name}: time {float(rec.t)} does not follow {float(prev.t)}")
         return rec
 
     def reset(self, x0_lo: Any, x0_hi: Any, first: MissionRecord) -> None:
@@ -158,21 +164,22 @@ class OnlineDigSlam:
         if not self.consistent:
             return
         start = time.perf_counter()
-        lo, hi = self.pose_lo, self.pose_hi
-        h, y, v = rec.heading, rec.yaw_rate, rec.speed
-        ok, hl, hh, x0, y0, x1, y1, *d = predict(lo[0], lo[1], hi[0], hi[1], self.heading_lo, self.heading_hi,
-                                                 float(rec.t) - float(self._prev.t), y[0], y[1], h[0], h[1],
-                                                 v[0], v[1])  # fmt: skip
-        if not ok:
+        d, out = self.dig, np.empty(10)  # out: the new pose box, heading and displacement (fresh arrays)
+        code, r0, r1, c0, c1 = filter_step(d.free, self.sensed_sure, self.sensed_maybe, d.xs, d.ys, d.nys,
+                                           d.frame, self.pose_lo, self.pose_hi, self.heading_lo,
+                                           self.heading_hi, out, float(rec.t) - float(self._prev.t),
+                                           rec.yaw_rate, rec.heading, rec.speed, rec.alpha, rec.gamma,
+                                           rec.r_max, rec.range, rec.no_echo, self._impacts)  # fmt: skip
+        if code:
             return self._fail(start)
-        lo, hi = np.array([x0, y0]), np.array([x1, y1])
-        self.heading_lo, self.heading_hi = hl, hh
-        if self.config.impacts:
-            lo, hi = self.dig.contract_box(lo, hi, self._impact_bound(rec))
-        if not (lo[0] <= hi[0] and lo[1] <= hi[1]):
-            return self._fail(start)
-        self.pose_lo, self.pose_hi = lo, hi
-        self._measure(rec, np.array(d))
+        self.pose_lo, self.pose_hi = out[0:2], out[2:4]
+        self.heading_lo, self.heading_hi = float(out[4]), float(out[5])
+        self._touch(r0, r1, c0, c1)
+        if self.config.smoothing_window:
+            psi = (self.heading_lo, self.heading_hi)
+            self._ring.append([rec, self.pose_lo.copy(), self.pose_hi.copy(), psi, out[6:10]])
+        self._prev = rec
+        self.steps += 1
         if self.config.smoothing_window and not self._smooth():
             return self._fail(start)
         self.last_update_seconds = time.perf_counter() - start
@@ -199,10 +206,16 @@ class OnlineDigSlam:
         r0, r1, c0, c1 = dig_and_mark(d.free, self.sensed_sure, self.sensed_maybe, d.xs, d.ys, d.nys, lo[0],
                                       lo[1], hi[0], hi[1], psi[0], psi[1], rec.alpha, rec.gamma, rec.r_max,
                                       rec.range, mark)  # fmt: skip
-        t0, t1, u0, u1 = self.touched
-        if r0 < r1 and c0 < c1:  # the window holding every changed cell
-            t = (min(t0, r0), max(t1, r1), min(u0, c0), max(u1, c1))
-            self.touched = (r0, r1, c0, c1) if t0 >= t1 else t
+        self._touch(r0, r1, c0, c1)
+
+    def _touch(self, r0: int, r1: int, c0: int, c1: int) -> None:
+        """Grow :attr:`touched` to hold the window ``[r0:r1, c0:c1]`` of changed cells."""
+        if r0 < r1 and c0 < c1:
+            t0, t1, u0, u1 = self.touched
+            if t0 >= t1:
+                self.touched = (r0, r1, c0, c1)
+            else:
+                self.touched = (min(t0, r0), max(t1, r1), min(u0, c0), max(u1, c1))
 
     def _measure(self, rec: MissionRecord, d: np.ndarray | None) -> None:
         """Dig the readings of the current step and grow the possibly sensed zone; push the step."""

@@ -72,6 +72,8 @@ class WindowDigMap(DigMap):
         self._xs, self._nys = grid.xs.tolist(), (-grid.ys).tolist()
         self.xs, self.ys, self.nys = (np.array(v, dtype=np.float64) for v in (grid.xs, grid.ys, -grid.ys))
         self.keep, self.off = _slack(grid)
+        #: ``(gx⁻, gy⁻, gx⁺, gy⁺, dx, dy, keep, off)`` for :func:`.online_jit_step.filter_step`.
+        self.frame = np.array([*grid.lo, *grid.hi, *grid.cell_size, self.keep, self.off], dtype=np.float64)
 
     def win(self, lo: np.ndarray, hi: np.ndarray) -> tuple[int, int, int, int]:
         """:meth:`Grid.window` of one box ``(2,)``, as Python ints (bisection on the exact cell bounds)."""

@@ -132,9 +132,10 @@ def _axes(xs: np.ndarray, ys: np.ndarray, lo0: float, lo1: float, hi0: float, hi
 @njit
 def _dig_cone(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, nys: np.ndarray, lo0: float, lo1: float,
               hi0: float, hi1: float, t1: float, t2: float, r: float, disk: bool, ax: np.ndarray,
-              ay: np.ndarray, R0: int, C0: int) -> None:  # fmt: skip
+              ay: np.ndarray, R0: int, C0: int) -> tuple[int, int, int, int]:  # fmt: skip
     """Dig the cells inside ``[x] + {ρ < r, θ ∈ [t1, t2]}`` (``disk``: the whole disk), ``t2 - t1 <= π``;
     ``ax``, ``ay``: :func:`_axes` of a window from row ``R0``, column ``C0`` holding the reading's window.
+    Returns the window ``(r0, r1, c0, c1)`` of the cells it dug (empty: ``r0 >= r1``).
 
     The bounds that depend on the column only (``p_x`` terms) or on the row only (``p_y`` terms) are
     computed once; each cell then compares them. A comparison ``a ≥ b`` of two bounds is exact, and so is
@@ -150,8 +151,9 @@ def _dig_cone(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, nys: np.ndarra
     r0, r1 = max(r0, R0), min(r1, R0 + ay.shape[1])
     c0, c1 = max(c0, C0), min(c1, C0 + ax.shape[1])
     if r0 >= r1 or c0 >= c1:
-        return
+        return 0, 0, 0, 0
     r2 = mul_dn(r, r)
+    u0, u1, v0, v1 = r1, r0, c1, c0  # the window of the dug cells
     n = c1 - c0
     sx1, sx2 = np.zeros(n), np.zeros(n)
     xl, xh, fx2 = ax[0, c0 - C0 : c1 - C0], ax[1, c0 - C0 : c1 - C0], ax[2, c0 - C0 : c1 - C0]
@@ -174,26 +176,40 @@ def _dig_cone(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, nys: np.ndarra
             if disk or (cy1 >= sx1[k] and sx2[k] >= cy2):
                 fr[k] = True
                 sr[k] = True
+                u0, u1, v0, v1 = min(u0, i), max(u1, i + 1), min(v0, c0 + k), max(v1, c0 + k + 1)
+    return u0, u1, v0, v1
 
 
 @njit
 def _dig(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, nys: np.ndarray, lo0: float, lo1: float,
          hi0: float, hi1: float, psi_lo: float, psi_hi: float, alpha: float, gamma: float, r: float,
-         disk: bool, ax: np.ndarray, ay: np.ndarray, R0: int, C0: int) -> None:  # fmt: skip
-    """:func:`dig_cells` on shared :func:`_axes`."""
+         disk: bool, ax: np.ndarray, ay: np.ndarray, R0: int, C0: int
+         ) -> tuple[int, int, int, int]:  # fmt: skip
+    """:func:`dig_cells` on shared :func:`_axes`; returns the window of the dug cells (:func:`_dig_cone`)."""
     if not (math.isfinite(r) and r > 0.0):
-        return
+        return 0, 0, 0, 0
     if disk:
-        _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, 0.0, 0.0, r, True, ax, ay, R0, C0)
-        return
+        return _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, 0.0, 0.0, r, True, ax, ay, R0, C0)
     t1, t2 = sub_up(add_up(psi_hi, alpha), gamma), add_dn(add_dn(psi_lo, alpha), gamma)
     if not (math.isfinite(t1) and math.isfinite(t2) and t1 <= t2):
-        return
+        return 0, 0, 0, 0
     if sub_up(t2, t1) > PI_DOWN:  # [θ₁, θ₁ + π⁻] and [θ₂ - π⁻, θ₂], both inside [θ₁, θ₂]
-        _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, t1, add_dn(t1, PI_DOWN), r, False, ax, ay, R0, C0)
-        _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, sub_up(t2, PI_DOWN), t2, r, False, ax, ay, R0, C0)
-    else:
-        _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, t1, t2, r, False, ax, ay, R0, C0)
+        t3, t4 = add_dn(t1, PI_DOWN), sub_up(t2, PI_DOWN)
+        a = _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, t1, t3, r, False, ax, ay, R0, C0)
+        b = _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, t4, t2, r, False, ax, ay, R0, C0)
+        return union(a, b)
+    return _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, t1, t2, r, False, ax, ay, R0, C0)
+
+
+@njit(inline="always")
+def union(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> tuple[int, int, int, int]:
+    """Smallest window ``(r0, r1, c0, c1)`` holding the windows ``a`` and ``b`` (empty: ``r0 >= r1`` or
+    ``c0 >= c1``)."""
+    if a[0] >= a[1] or a[2] >= a[3]:
+        return b
+    if b[0] >= b[1] or b[2] >= b[3]:
+        return a
+    return min(a[0], b[0]), max(a[1], b[1]), min(a[2], b[2]), max(a[3], b[3])
 
 
 @njit

@@ -29,7 +29,7 @@ import math
 import numpy as np
 
 from .jit import add_dn, add_up, mul_up, njit, sub_dn, sub_up
-from .online_jit import _box_ok, _cone_window, _dig, _edge, _phi, _plo, _reach_axes, window
+from .online_jit import _box_ok, _cone_window, _dig, _edge, _phi, _plo, _reach_axes, union, window
 from .rounding import HALF_PI_DOWN, PI_DOWN
 
 __all__ = ["mark_cells", "mark_batch", "dig_and_mark"]
@@ -38,10 +38,11 @@ __all__ = ["mark_cells", "mark_batch", "dig_and_mark"]
 @njit
 def _mark(maybe: np.ndarray, xs: np.ndarray, nys: np.ndarray, lo0: float, lo1: float, hi0: float, hi1: float,
           psi_lo: float, psi_hi: float, alpha: float, gamma: float, r: float, ax: np.ndarray, ay: np.ndarray,
-          R0: int, C0: int) -> None:  # fmt: skip
-    """:func:`mark_cells` on shared :func:`_axes` (their window must hold the reading's window)."""
+          R0: int, C0: int) -> tuple[int, int, int, int]:  # fmt: skip
+    """:func:`mark_cells` on shared :func:`_axes` (their window must hold the reading's window); returns
+    the window ``(r0, r1, c0, c1)`` of the cells it marked (empty: ``r0 >= r1``)."""
     if not (math.isfinite(r) and r > 0.0):
-        return
+        return 0, 0, 0, 0
     t1, t2 = sub_dn(add_dn(psi_lo, alpha), gamma), add_up(add_up(psi_hi, alpha), gamma)
     narrow = math.isfinite(t1) and math.isfinite(t2) and sub_up(t2, t1) <= HALF_PI_DOWN
     pad = 2.0 * max(xs[1] - xs[0], -nys[1] + nys[0])
@@ -54,8 +55,9 @@ def _mark(maybe: np.ndarray, xs: np.ndarray, nys: np.ndarray, lo0: float, lo1: f
     r0, r1 = max(r0, R0), min(r1, R0 + ay.shape[1])
     c0, c1 = max(c0, C0), min(c1, C0 + ax.shape[1])
     if r0 >= r1 or c0 >= c1:
-        return
+        return 0, 0, 0, 0
     r2 = mul_up(r, r)
+    u0, u1, v0, v1 = r1, r0, c1, c0  # the window of the marked cells
     # a cone of aperture < π whose two edges lie in a closed half-plane lies in it
     right, left = c1l >= 0.0 and c2l >= 0.0, c1h <= 0.0 and c2h <= 0.0
     top, bottom = s1l >= 0.0 and s2l >= 0.0, s1h <= 0.0 and s2h <= 0.0
@@ -81,6 +83,8 @@ def _mark(maybe: np.ndarray, xs: np.ndarray, nys: np.ndarray, lo0: float, lo1: f
             if narrow and (cy1 < sx1[k] or sx2[k] < cy2 or out_col[k]):
                 continue
             mr[k] = True
+            u0, u1, v0, v1 = min(u0, i), max(u1, i + 1), min(v0, c0 + k), max(v1, c0 + k + 1)
+    return u0, u1, v0, v1
 
 
 @njit
@@ -110,8 +114,8 @@ def dig_and_mark(free: np.ndarray, sure: np.ndarray, maybe: np.ndarray, xs: np.n
                  mark: bool) -> tuple[int, int, int, int]:  # fmt: skip
     """One step's readings from one pose box: dig each free range ``min(y⁻, r_max)`` (``gamma >= π⁻`` is
     the omnidirectional disk); with ``mark``, grow ``Z⁺`` with ``min(y⁺, r_max)`` (``rng``: ``(n, 2)``).
-    The per-row and per-column bounds (:func:`_axes`) are computed once for all the readings; returns their
-    window ``(r0, r1, c0, c1)``, which holds every cell changed."""
+    The per-row and per-column bounds (:func:`_axes`) are computed once for all the readings; returns the
+    smallest window ``(r0, r1, c0, c1)`` holding every cell changed (``(0, 0, 0, 0)`` when none)."""
     if not _box_ok(lo0, lo1, hi0, hi1):
         return 0, 0, 0, 0
     reach = 0.0
@@ -120,11 +124,12 @@ def dig_and_mark(free: np.ndarray, sure: np.ndarray, maybe: np.ndarray, xs: np.n
             if math.isfinite(r):
                 reach = max(reach, r)
     ax, ay, R0, C0 = _reach_axes(xs, ys, nys, lo0, lo1, hi0, hi1, reach)
+    w = (0, 0, 0, 0)
     for k in range(alpha.size):
-        _dig(free, sure, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha[k], gamma[k],
-             min(rng[k, 0], r_max[k]), gamma[k] >= PI_DOWN, ax, ay, R0, C0)  # fmt: skip
+        w = union(w, _dig(free, sure, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha[k], gamma[k],
+                          min(rng[k, 0], r_max[k]), gamma[k] >= PI_DOWN, ax, ay, R0, C0))  # fmt: skip
     if mark:
         for k in range(alpha.size):
-            _mark(maybe, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha[k], gamma[k],
-                  min(rng[k, 1], r_max[k]), ax, ay, R0, C0)  # fmt: skip
-    return R0, R0 + ay.shape[1], C0, C0 + ax.shape[1]
+            w = union(w, _mark(maybe, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha[k], gamma[k],
+                               min(rng[k, 1], r_max[k]), ax, ay, R0, C0))  # fmt: skip
+    return w

@@ -274,3 +274,22 @@ def test_offline_observer_on_a_re_indexed_env_mission_contains_the_truth() -> No
     res = dig_slam(ep.records, grid, start, start, DigSlamConfig(max_iter=2))
     assert res.consistent
     assert np.all(res.tube.contains(ep.records.t, ep.truth.pose[:, :2]))
+
+
+def test_wrapper_skips_only_the_raw_observation_it_replaces() -> None:
+    from digslam.envs.explore_env import ExploreEnv
+    from digslam.envs.observer_wrapper import GuaranteedObserver
+
+    raw, ref = ExploreEnv(), ExploreEnv()
+    assert raw.raw_observation and ref.raw_observation
+    env = GuaranteedObserver(raw, map_size=36)
+    assert not raw.raw_observation
+    env.reset(seed=3)
+    ref.reset(seed=3)
+    a = np.array([0.7, 0.2], np.float32)
+    obs, reward, _, _, info = env.step(a)
+    ref_obs, ref_reward, _, _, ref_info = ref.step(a)
+    assert set(obs) == {"map", "state"} and ref.observation_space.contains(ref_obs)
+    assert info["coverage"] == ref_info["coverage"] == info["true_coverage"] and reward == ref_reward
+    assert info["record"].same_as(ref_info["record"])
+    assert raw.step(a)[0] is None and ref.step(a)[0] is not None

@@ -323,3 +323,89 @@ def test_wrapper_sets_kept_up_to_date_equal_the_filter_sets(window: int) -> None
                 info["clear"][:] = True  # the agent's copies are its own
             a = np.array([rng.uniform(0.3, 1.0), rng.uniform(-1, 1)], np.float32)
             obs, _, _, _, info = env.step(a)
+
+
+def test_dig_and_mark_window_holds_every_changed_cell_and_filter_step_matches_the_kernels() -> None:
+    from digslam.observer.online_jit_mark import dig_and_mark
+    from digslam.observer.online_jit_pose import contract, impact_bound
+    from digslam.observer.online_jit_step import filter_step
+
+    g = Grid((-4.0, -4.0), (4.0, 4.0), (64, 64))
+    d = WindowDigMap(g)
+    rng = np.random.default_rng(11)
+    free, sure, maybe = (np.zeros(g.shape, bool) for _ in range(3))
+    alpha = np.array([0.0, 1.0, -2.0, np.pi / 2, 0.0])
+    gamma = np.array([0.3, 0.2, 0.4, 0.26, np.pi])
+    r_max = np.full(5, 3.0)
+    lo, hi, h = np.array([-0.1, -0.2]), np.array([0.1, 0.0]), (-0.05, 0.05)
+    for _ in range(40):
+        rg = np.sort(rng.uniform(0.2, 3.5, (5, 2)), axis=1)
+        no_echo = rg[:, 0] > 3.0
+        rg[no_echo] = [3.0, np.inf]
+        yaw, comp, speed = np.array([-0.3, 0.3]), np.array([h[0] - 0.1, h[1] + 0.1]), np.array([0.4, 0.6])
+        f0, s0, m0 = free.copy(), sure.copy(), maybe.copy()
+        # the fused step equals predict + Eq. 6.22 + dig_and_mark called one by one
+        ok, hl, hh, x0, y0, x1, y1, *disp = predict(lo[0], lo[1], hi[0], hi[1], h[0], h[1], 0.1, *yaw, *comp,
+                                                    *speed)  # fmt: skip
+        assert ok
+        rb = impact_bound(no_echo, rg)
+        if math.isfinite(rb):
+            x0, y0, x1, y1 = contract(f0, d.xs, d.ys, d.nys, x0, y0, x1, y1, rb, *g.cell_size, d.keep, d.off)
+        st = np.empty(10)
+        code, *win = filter_step(free, sure, maybe, d.xs, d.ys, d.nys, d.frame, lo, hi, h[0], h[1], st, 0.1,
+                                 yaw, comp, speed, alpha, gamma, r_max, rg, no_echo, True)  # fmt: skip
+        if not x0 <= x1 or not y0 <= y1:  # the random ranges contradict the dug cells: start again
+            assert code == 1
+            lo, hi, h = np.array([-0.1, -0.2]), np.array([0.1, 0.0]), (-0.05, 0.05)
+            free[:], sure[:], maybe[:] = False, False, False
+            continue
+        assert code == 0 and st.tolist() == [x0, y0, x1, y1, hl, hh, *disp]
+        f1, s1, m1 = f0.copy(), s0.copy(), m0.copy()
+        assert dig_and_mark(f1, s1, m1, d.xs, d.ys, d.nys, x0, y0, x1, y1, hl, hh, alpha, gamma, r_max, rg,
+                            True) == tuple(win)  # fmt: skip
+        assert np.array_equal(f1, free) and np.array_equal(s1, sure) and np.array_equal(m1, maybe)
+        changed = (free != f0) | (sure != s0) | (maybe != m0)
+        r0, r1, c0, c1 = win
+        outside = changed.copy()
+        outside[r0:r1, c0:c1] = False
+        assert not outside.any() and (changed.any() or (r0 >= r1 or c0 >= c1))
+        if changed.any():  # the smallest such window
+            rows, cols = np.nonzero(changed)
+            assert (r0, r1, c0, c1) == (rows.min(), rows.max() + 1, cols.min(), cols.max() + 1)
+        lo, hi, h = st[0:2].copy(), st[2:4].copy(), (st[4], st[5])
+        lo, hi = np.clip(lo, -3.0, 3.0), np.clip(np.maximum(hi, lo), -3.0, 3.0)
+
+
+def test_observe_matches_its_pieces() -> None:
+    from digslam.envs.observer_maps import observe, pixel_blocks, pixel_range, sets_and_map
+    from digslam.observer.online_jit import window
+
+    rng = np.random.default_rng(6)
+    for n, m in ((40, 36), (30, 64), (64, 64)):
+        g = Grid((-2.0, -2.0), (2.0, 2.0), (n, n))
+        sure, maybe, free, reach = (rng.random((n, n)) < p for p in (0.3, 0.6, 0.7, 0.8))
+        maybe |= sure
+        planes = np.zeros((4, n, n), np.uint8)
+        planes[3] = reach
+        explored, clear, dark = (np.zeros((n, n), t) for t in (np.int8, bool, bool))
+        base, ref_base = np.zeros((3, m, m), np.uint8), np.zeros((3, m, m), np.uint8)
+        lo, hi = np.sort(rng.uniform(-2.0, 2.0, (2, 2)), axis=0)
+        img, state = np.empty((4, m, m), np.uint8), np.empty(11, np.float32)
+        norm = np.array([0.0, 0.0, 2.0, 2.0, 100.0])
+        win = (3, n - 5, 2, n // 2)
+        ref = sets_and_map(sure, maybe, free, reach, explored, clear, dark, ref_base, win)
+        snap = np.empty((3, n, n), np.uint8)
+        got = observe(sure, maybe, free, planes, base, img, win, g.xs, -g.ys, lo, hi, (0.1, 0.3), norm, 7,
+                      int(reach.sum()), 5, state, snap)  # fmt: skip
+        assert np.array_equal(snap[:2], planes[:2]) and np.array_equal(snap[2], free)
+        assert got == ref + 5 and np.array_equal(base, ref_base) and np.array_equal(img[:3], ref_base)
+        assert np.array_equal(planes[0].view(np.int8)[3 : n - 5, 2 : n // 2], explored[3 : n - 5, 2 : n // 2])
+        r0, r1, c0, c1 = window(g.xs, -g.ys, lo[0], lo[1], hi[0], hi[1])
+        p0, p1 = pixel_range(r0, r1, n, m)
+        q0, q1 = pixel_range(c0, c1, n, m)
+        foot = np.zeros((m, m), np.uint8)
+        foot[p0:p1, q0:q1] = 255
+        assert np.array_equal(img[3], foot) and pixel_blocks((n, n), m).shape == (4, m)
+        want = [lo[0] / 2, lo[1] / 2, hi[0] / 2, hi[1] / 2, math.cos(0.2), math.sin(0.2), 0.1 / math.pi,
+                math.tanh(max(hi - lo)), 0.07, (ref + 5) / reach.sum(), 1.0]  # fmt: skip
+        assert np.array_equal(state, np.array(want, np.float32))
