@@ -278,13 +278,24 @@ def _image_kernel(code: np.ndarray, cst: np.ndarray, outs: np.ndarray, lo: np.nd
     return res
 
 
+#: Rows per kernel call: the kernels hold ``2 K`` values per row (``K`` tape nodes), so huge batches
+#: (a fine ``classify_grid``, a big paver generation) go through in blocks of bounded memory.
+BLOCK = 1 << 18
+
+
 def _c(a: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(a, dtype=np.float64)
 
 
 def image(t: Tape, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``[f]([x])`` as an ``(N, m)`` batch (empty rows for empty boxes)."""
-    res = _image_kernel(t.code, t.cst, t.outputs, _c(lo), _c(hi))
+    lo, hi = _c(lo), _c(hi)
+    if lo.shape[0] <= BLOCK:
+        res = _image_kernel(t.code, t.cst, t.outputs, lo, hi)
+        return res[0], res[1]
+    res = np.empty((2, lo.shape[0], t.outputs.shape[0]))
+    for i in range(0, lo.shape[0], BLOCK):
+        res[:, i : i + BLOCK] = _image_kernel(t.code, t.cst, t.outputs, lo[i : i + BLOCK], hi[i : i + BLOCK])
     return res[0], res[1]
 
 
@@ -293,10 +304,24 @@ def hc4(t: Tape, lo: np.ndarray, hi: np.ndarray, ylo: np.ndarray,
     """HC4-revise of ``f(x) ∈ [y]`` on a batch; ``[y]`` is ``(m,)`` or ``(N, m)`` per box."""
     shape = (lo.shape[0], t.outputs.shape[0])
     y = np.stack([np.broadcast_to(ylo, shape), np.broadcast_to(yhi, shape)]).astype(np.float64)
-    res = _hc4_kernel(t.code, t.cst, t.outputs, _c(lo), _c(hi), y)
+    lo, hi = _c(lo), _c(hi)
+    if lo.shape[0] <= BLOCK:
+        res = _hc4_kernel(t.code, t.cst, t.outputs, lo, hi, y)
+        return res[0], res[1]
+    res = np.empty((2, *lo.shape))
+    for i in range(0, lo.shape[0], BLOCK):
+        b = slice(i, i + BLOCK)
+        res[:, b] = _hc4_kernel(t.code, t.cst, t.outputs, lo[b], hi[b], np.ascontiguousarray(y[:, b]))
     return res[0], res[1]
 
 
 def sep_box(t: Tape, lo: np.ndarray, hi: np.ndarray, y: np.ndarray) -> np.ndarray:
     """``(4, N, n)``: ``x_in`` (lo, hi) then ``x_out`` of the separator of ``f⁻¹([y])``, ``y (2, m)``."""
-    return _sep_box_kernel(t.code, t.cst, t.outputs, _c(lo), _c(hi), _c(y)[:, None, :])
+    lo, hi, yy = _c(lo), _c(hi), _c(y)[:, None, :]
+    if lo.shape[0] <= BLOCK:
+        return _sep_box_kernel(t.code, t.cst, t.outputs, lo, hi, yy)
+    res = np.empty((4, *lo.shape))
+    for i in range(0, lo.shape[0], BLOCK):
+        b = slice(i, i + BLOCK)
+        res[:, b] = _sep_box_kernel(t.code, t.cst, t.outputs, lo[b], hi[b], yy)
+    return res

@@ -184,3 +184,23 @@ def test_paver_reproduces_the_numpy_paver_figures(problem: str, bisections: int,
     assert p.inner_area == pytest.approx(inner, rel=2e-6) and p.boundary_area == pytest.approx(boundary, rel=2e-6)
     assert p.tree.size == 2 * bisections + 1
     assert p.inner_area + p.outer_area + p.boundary_area == pytest.approx(float(np.prod(x0.hi - x0.lo)))
+
+
+def test_blocks_of_a_huge_batch_give_the_same_result(monkeypatch) -> None:
+    """Batches above ``jit_hc4.BLOCK`` rows go through in blocks, with the same results as one call."""
+    from digslam.observer import jit_hc4
+
+    f = Function(lambda x: (x[0] - 2) ** 2 + (x[1] - 2.5) ** 2)
+    t = Tape.of(f)
+    rng = np.random.default_rng(7)
+    c = rng.uniform(-1, 5, (1000, 2))
+    w = rng.uniform(0, 0.5, (1000, 2))
+    lo, hi = c - w, c + w
+    y = np.array([[1.0], [2.25]])
+    whole = (jit_hc4.sep_box(t, lo, hi, y), jit_hc4.image(t, lo, hi), jit_hc4.hc4(t, lo, hi, y[0], y[1]))
+    monkeypatch.setattr(jit_hc4, "BLOCK", 64)
+    blocks = (jit_hc4.sep_box(t, lo, hi, y), jit_hc4.image(t, lo, hi), jit_hc4.hc4(t, lo, hi, y[0], y[1]))
+    np.testing.assert_array_equal(whole[0], blocks[0])
+    for a, b in zip(whole[1:], blocks[1:]):
+        np.testing.assert_array_equal(a[0], b[0])
+        np.testing.assert_array_equal(a[1], b[1])
