@@ -63,13 +63,6 @@ def point_edge_distance(points: np.ndarray, edges: Edges) -> np.ndarray:
     return out
 
 
-def edges_near(edges: Edges, bbox: np.ndarray, x: float, y: float, reach: float) -> Edges:
-    """Edges whose bounding box ``(E, 4)`` (xmin, ymin, xmax, ymax) comes within ``reach`` of ``(x, y)``."""
-    dx = np.maximum(np.maximum(bbox[:, 0] - x, x - bbox[:, 2]), 0.0)
-    dy = np.maximum(np.maximum(bbox[:, 1] - y, y - bbox[:, 3]), 0.0)
-    return edges[dx * dx + dy * dy <= reach * reach]
-
-
 def edge_bboxes(edges: Edges) -> np.ndarray:
     """Bounding boxes ``(E, 4)`` of the edges."""
     return jit.edge_boxes(edges)
@@ -85,7 +78,7 @@ def sector_distance(
         y: Apex ordinate.
         axis: World-frame sector directions (rad), shape ``(S,)``; any real value (no ``±pi`` cut).
         gamma: Half-apertures in ``(0, pi]``, shape ``(S,)``.
-        edges: Edge array ``(E, 4)`` (pre-filter it with :func:`edges_near`).
+        edges: Edge array ``(E, 4)`` (the kernel skips edges whose bounding box cannot beat a sector's best).
         return_witness: Also return the nearest points ``(S, 2)`` (NaN where none).
 
     Returns:

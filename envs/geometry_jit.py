@@ -1,7 +1,7 @@
 """Compiled kernels of the simulator's exact geometry: sector distances and point-edge distances.
 
 Each kernel loops over the world's edges in machine code (:func:`digslam.observer.jit.njit`), with the
-bounding-box pre-filter of :func:`.geometry.edges_near` fused in (an edge whose box lies farther than
+bounding-box pre-filter fused in (an edge whose box lies farther than
 ``reach`` from the point is skipped; ``reach = inf`` keeps every edge). They compute the simulator's truth,
 a float64 value widened afterwards by :data:`.sensors.SIM_TOL`, with the same formulas as the numpy code
 they replace (kept as test oracles in ``tests/test_sim_jit.py``):
@@ -49,7 +49,7 @@ def edge_boxes(edges: np.ndarray) -> np.ndarray:
 
 @njit(inline="always")
 def _near(bbox: np.ndarray, k: int, x: float, y: float, reach2: float) -> bool:
-    """Whether edge ``k``'s box comes within ``sqrt(reach2)`` of ``(x, y)`` (cf. ``edges_near``)."""
+    """Whether edge ``k``'s box comes within ``sqrt(reach2)`` of ``(x, y)``."""
     dx = max(max(bbox[k, 0] - x, x - bbox[k, 2]), 0.0)
     dy = max(max(bbox[k, 1] - y, y - bbox[k, 3]), 0.0)
     return dx * dx + dy * dy <= reach2

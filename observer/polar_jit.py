@@ -33,8 +33,6 @@ from .polar_jit_ops import (
     pdiv,
     pmul,
     point_angle,
-    tsub_dn,
-    tsub_up,
 )
 from .rounding import PI_DOWN, PI_UP, TWO_PI_DOWN, TWO_PI_UP
 
@@ -259,7 +257,7 @@ def sep_pie_batch(lo: np.ndarray, hi: np.ndarray, m: np.ndarray, reflect: bool, 
         if not (xl <= xh and yl <= yh):
             continue
         if reflect:
-            xl, xh, yl, yh = tsub_dn(m[0], xh), tsub_up(m[0], xl), tsub_dn(m[1], yh), tsub_up(m[1], yl)
+            xl, xh, yl, yh = sub_dn(m[0], xh), sub_up(m[0], xl), sub_dn(m[1], yh), sub_up(m[1], yl)
         mx, my = max(abs(xl), abs(xh)), max(abs(yl), abs(yh))
         gx = 0.0 if xl <= 0 <= xh else min(abs(xl), abs(xh))
         gy = 0.0 if yl <= 0 <= yh else min(abs(yl), abs(yh))
@@ -299,7 +297,7 @@ def sep_pie_batch(lo: np.ndarray, hi: np.ndarray, m: np.ndarray, reflect: bool, 
         for g in (0, 2):
             ul, uh, vl, vh = res[g, i, 0], res[g + 1, i, 0], res[g, i, 1], res[g + 1, i, 1]
             if reflect and ul <= uh and vl <= vh:
-                ul, uh, vl, vh = tsub_dn(m[0], uh), tsub_up(m[0], ul), tsub_dn(m[1], vh), tsub_up(m[1], vl)
+                ul, uh, vl, vh = sub_dn(m[0], uh), sub_up(m[0], ul), sub_dn(m[1], vh), sub_up(m[1], vl)
                 ul, uh, vl, vh = max(ul, lo[i, 0]), min(uh, hi[i, 0]), max(vl, lo[i, 1]), min(vh, hi[i, 1])
             if not (ul <= uh and vl <= vh):
                 ul, uh, vl, vh = _INF, -_INF, _INF, -_INF

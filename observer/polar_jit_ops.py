@@ -19,7 +19,7 @@ import numpy as np
 from .jit import add_dn, add_up, dn, mul_dn, mul_up, njit, sqrt_dn, sqrt_up, sub_dn, sub_up, up, wdn, wup
 from .rounding import HALF_PI_DOWN, HALF_PI_UP, PI_DOWN, PI_UP, TWO_PI_DOWN, TWO_PI_UP
 
-__all__ = ["cos_sin", "point_angle", "lift", "cross", "pmul", "pdiv", "tsub_dn", "tsub_up",
+__all__ = ["cos_sin", "point_angle", "lift", "cross", "pmul", "pdiv",
            "disk_hull", "outside_hull"]
 
 _INF = math.inf
@@ -148,28 +148,6 @@ def pdiv(a: float, c0: float, c1: float) -> tuple[float, float]:
         return -_INF, _INF
     p, q = a / c0, a / c1
     return dn(min(p, q)), up(max(p, q))
-
-
-@njit
-def _two_diff(a: float, b: float) -> tuple[float, float]:
-    """``a - b = d + e`` exactly (Knuth's TwoSum on ``a + (-b)``); ``e`` is NaN on overflow."""
-    d = a - b
-    bb = d - a
-    return d, (a - (d - bb)) + (-b - bb)
-
-
-@njit
-def tsub_dn(a: float, b: float) -> float:
-    """Lower bound of ``a - b``, equal to it when the difference is a float (``m - x`` stays exact)."""
-    d, e = _two_diff(a, b)
-    return d if e >= 0 else dn(d)
-
-
-@njit
-def tsub_up(a: float, b: float) -> float:
-    """Upper bound of ``a - b``, equal to it when the difference is a float."""
-    d, e = _two_diff(a, b)
-    return d if e <= 0 else up(d)
 
 
 @njit
