@@ -34,7 +34,7 @@ from .landmarks import (
 from .minkowski import SepMinkowskiDiff, SepMinkowskiSum, sep_negate
 from .online import OnlineConfig, OnlineDigSlam
 from .ops import abs_, acos, asin, atan, atan2, cos, exp, log, maximum, minimum, pown, sin, sqr, sqrt, tan
-from .paver import Paving, PavingTree, classify_grid, pave
+from .paver import Paving, PavingTree, pave
 from .polar_ctc import CtcPolar
 from .polar_sep import (
     SepCtcPreimage,
@@ -56,6 +56,7 @@ from .registration import (
     transform_function,
     translation,
 )
+from .regular import classify_grid
 from .sep_image import CtcImage, SepImage
 from .sep_inverse import SepInverse
 from .sep_polygon import CtcPolygonBoundary, CtcSegments, SepPolygon

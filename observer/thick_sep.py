@@ -120,7 +120,7 @@ def thick_relaxed_intersection(seps: list[ThickSep], q: int) -> ThickSep:
 def thick_classify_grid(x0: Any, tsep: ThickSep, shape: tuple[int, int]) -> np.ndarray:
     """Classify the cells of an ``(ny, nx)`` grid over a 2-d box into clear/penumbra/dark.
 
-    Same cell layout as :func:`observer.paver.classify_grid` (row 0 is the top, largest ``y``).
+    Same cell layout as :func:`observer.regular.classify_grid` (row 0 is the top, largest ``y``).
 
     Returns:
         ``int8 (ny, nx)``: ``1`` clear, ``2`` penumbra, ``-1`` dark, ``0`` unknown.

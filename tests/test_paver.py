@@ -137,3 +137,47 @@ def test_pave_bad_input(kwargs: dict, message: str) -> None:
     args = {"x0": X0, "sep": SepInverse(RING_F, Interval(1, 2.25)), "eps": 0.1} | kwargs
     with pytest.raises(ValueError, match=message):
         pave(**args)
+
+
+@pytest.mark.parametrize("eps", [0.05, 0.01])
+def test_grid_cut_and_max_volume_keep_the_enclosure(eps: float) -> None:
+    """``cut="grid"`` and ``max_volume`` move cuts, never claims: same partition and enclosure, and the
+    boundary boxes keep ``w∞ < ε`` and respect the volume bound."""
+    sep = SepInverse(RING_F, Interval(1, 2.25))
+    mid = pave(X0, sep, eps)
+    for kw in ({"cut": "grid"}, {"cut": "grid", "max_volume": eps**2 / 2}, {"max_volume": eps**2 / 4}):
+        p = pave(X0, sep, eps, **kw)
+        assert p.inner_area <= RING_AREA <= p.inner_area + p.boundary_area
+        assert p.inner_area + p.outer_area + p.boundary_area == pytest.approx(36.0, rel=1e-12)
+        w = np.maximum(p.boundary[1] - p.boundary[0], 0)
+        assert (w.max(axis=1) < eps).all()
+        if "max_volume" in kw:
+            assert (w.prod(axis=1) < kw["max_volume"]).all()
+        assert p.bisections == p.tree.size // 2
+        rng = np.random.default_rng(2)
+        assert ring_member(rng.uniform(*p.inner)).all()
+        assert not ring_member(rng.uniform(*p.outer)).any()
+    grid = pave(X0, sep, eps, cut="grid")
+    assert grid.bisections < mid.bisections  # boxes just under ε instead of ε/2 … ε
+    vol = pave(X0, sep, eps, cut="grid", max_volume=eps**2 / 2)
+    assert vol.boundary_area < grid.boundary_area
+
+
+def test_grid_cut_on_a_side_too_narrow_to_split_terminates() -> None:
+    """ε below the float resolution of the coordinates: the box that cannot be split stays undetermined
+    (with ``cut="ratio"`` too) instead of being bisected into itself forever."""
+    sep = SepInverse(Function(lambda x: 3 * x[0], n=2), Interval(3e8 + 1, 6e8))  # x₁ ≥ 1e8 + 1/3, rounded
+    x0 = Box([(1e8 + 1 / 3 - 1e-7, 1e8 + 1 / 3 + 1e-7), (0.0, 1e-10)])
+    for kw in ({}, {"cut": "grid"}):
+        p = pave(x0, sep, 1e-12, **kw)
+        w = p.boundary[1] - p.boundary[0]
+        assert len(w) and (w[:, 0] <= np.spacing(1e8)).all()  # one ulp: the side that cannot be cut
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [({"cut": "middle"}, "cut"), ({"max_volume": 0.0}, "max_volume"), ({"max_volume": np.inf}, "max_volume")],
+)
+def test_pave_bad_policy(kwargs: dict, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        pave(X0, SepInverse(RING_F, Interval(1, 2.25)), 0.1, **kwargs)

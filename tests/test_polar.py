@@ -251,6 +251,38 @@ def test_landmark_beats_forward_backward() -> None:
     assert not check_separation(xin, xout, lo, hi).any()
 
 
+#: codac 2.1.2's best pavings of the landmark of §3.4.1.1 (``benchmarks/bench_polar.py``): bisections
+#: and undetermined area of ``pave`` with ``SepInverse`` (its fewest bisections at both ε).
+CODAC_BEST = {0.01: (1818, 0.037320), 0.001: (17161, 0.004060)}
+
+
+@pytest.mark.parametrize("eps", [0.01, 0.001])
+def test_landmark_paving_beats_codac_at_equal_eps(eps: float) -> None:
+    """The minimal polar separator with the grid cut and ``max_volume = ε²/2``: fewer bisections and
+    less undetermined area than codac's best at the same ε, and the exact set stays enclosed."""
+    rho, theta = (4.0, 6.0), (-np.pi / 12, np.pi / 4)
+    p = pave(Box([(-6, 4), (-6, 4)]), SepLandmark((0, 0), rho, theta), eps, cut="grid", max_volume=eps**2 / 2)
+    bisections, area = CODAC_BEST[eps]
+    assert p.bisections < bisections and p.boundary_area < area
+    exact = 0.5 * (36 - 16) * (np.pi / 3)
+    assert p.inner_area <= exact <= p.inner_area + p.boundary_area
+    assert (np.maximum(p.boundary[1] - p.boundary[0], 0).max(axis=1) < eps).all()
+    rng = np.random.default_rng(5)
+    pts = rng.uniform(*p.inner)
+    r, a = np.hypot(pts[:, 0], pts[:, 1]), np.arctan2(-pts[:, 1], -pts[:, 0])  # m - x = π(ρ, θ)
+    assert ((r >= 4) & (r <= 6) & (a >= -np.pi / 12) & (a <= np.pi / 4)).all()
+
+
+def test_landmark_fewer_bisections_than_forward_backward_with_the_same_policy() -> None:
+    """§3.4.1.1 at ε = 0.01 with the grid cut: the minimal separator needs fewer bisections than
+    forward-backward, for the same undetermined area within 1 %."""
+    rho, theta = (4.0, 6.0), (-np.pi / 12, np.pi / 4)
+    x0, kw = Box([(-6, 4), (-6, 4)]), {"cut": "grid", "max_volume": 0.01**2 / 2}
+    pa = pave(x0, SepLandmark((0, 0), rho, theta), 0.01, **kw)
+    pb = pave(x0, fwd_bwd_landmark((0, 0), rho, theta), 0.01, **kw)
+    assert pa.bisections < pb.bisections and pa.boundary_area <= pb.boundary_area * 1.01
+
+
 @pytest.mark.parametrize(
     ("rho", "theta", "match"),
     [
