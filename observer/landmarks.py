@@ -31,13 +31,14 @@ import numpy as np
 from . import arith as A
 from .boxes import normalize_empty, validate_batch
 from .contractors import Ctc
-from .polar_ctc import contract_polar
+from .polar_ctc import CtcPolar
 from .tube import Tube, body_velocity, ctc_deriv
 
 Pair = tuple[np.ndarray, np.ndarray]
 Batch = tuple[np.ndarray, np.ndarray]
 _INF = np.inf
 _CHUNK = 1 << 22  # candidate (box, landmark) pairs examined at once
+_POLAR = CtcPolar()  # the compiled minimal polar contractor, Eq. 3.34 (step v)
 
 
 class CtcLandmarks(Ctc):
@@ -151,8 +152,8 @@ def contract_detections(lmap: CtcLandmarks, p: Batch, psi: Pair, m: Batch, rho: 
         mlo, mhi = lmap.contract(*normalize_empty(mlo, mhi))
         ax, ay = A.sub(_col(mlo, mhi, 0), _col(plo, phi_, 0)), A.sub(_col(mlo, mhi, 1), _col(plo, phi_, 1))
         alpha = A.add(psi, phi)
-        box = contract_polar(np.stack([ax[0], ay[0], rho[0], alpha[0]], 1),
-                             np.stack([ax[1], ay[1], rho[1], alpha[1]], 1))  # fmt: skip
+        box = _POLAR.contract(np.stack([ax[0], ay[0], rho[0], alpha[0]], 1),
+                              np.stack([ax[1], ay[1], rho[1], alpha[1]], 1))  # fmt: skip
         a = (box[0][:, :2], box[1][:, :2])
         mx = A.intersect(_col(mlo, mhi, 0), A.add(_col(plo, phi_, 0), _col(*a, 0)))
         my = A.intersect(_col(mlo, mhi, 1), A.add(_col(plo, phi_, 1), _col(*a, 1)))
@@ -193,8 +194,8 @@ def contract_disjunctive(lmap: CtcLandmarks, p: Batch, psi: Pair, m: Batch, rho:
     qx, qy = (q[:, 0], q[:, 0]), (q[:, 1], q[:, 1])
     ax, ay = A.sub(qx, sel(p, 0)), A.sub(qy, sel(p, 1))
     alpha = A.add((psi[0][d], psi[1][d]), (phi[0][d], phi[1][d]))
-    blo, bhi = contract_polar(np.stack([ax[0], ay[0], rho[0][d], alpha[0]], 1),
-                              np.stack([ax[1], ay[1], rho[1][d], alpha[1]], 1))  # fmt: skip
+    blo, bhi = _POLAR.contract(np.stack([ax[0], ay[0], rho[0][d], alpha[0]], 1),
+                               np.stack([ax[1], ay[1], rho[1][d], alpha[1]], 1))  # fmt: skip
     px, py = A.sub(qx, (blo[:, 0], bhi[:, 0])), A.sub(qy, (blo[:, 1], bhi[:, 1]))
     ps = A.sub((blo[:, 3], bhi[:, 3]), (phi[0][d], phi[1][d]))
     keep = ~(blo > bhi).any(axis=1)
