@@ -3,7 +3,8 @@
 codac runs in a subprocess (importing it switches this process to upward rounding). The last line is
 ``ratio_vs_codac=<our time / codac time>``, the worst case over the runs. Both cut boxes at 0.49 of their
 largest side (codac's default; ``--ratio 0.5`` for the thesis's midpoint), so the pavings are comparable
-box for box: the ring's are identical.
+box for box: the ring's are identical. ``--kappa K`` paves ours with ``cut="grid", max_volume=K ε²``
+instead (see :func:`pave`).
 """
 
 from __future__ import annotations
@@ -27,13 +28,14 @@ def problem(name: str):  # noqa: ANN201
     return Box([(-10, 10), (-10, 10)]), (s1 & s2) | (s3 & ~s1)  # Eq. 2.56
 
 
-def ours(name: str, eps: float, repeat: int, ratio: float) -> dict:
+def ours(name: str, eps: float, repeat: int, ratio: float, kappa: float | None = None) -> dict:
     x0, sep = problem(name)
+    kw = {} if kappa is None else {"cut": "grid", "max_volume": kappa * eps**2}
     pave(x0, sep, 0.5, ratio=ratio)  # warm-up: numba compiles (or loads) its kernels on the first call
     best, p = float("inf"), None
     for _ in range(repeat):
         t = time.perf_counter()
-        p = pave(x0, sep, eps, ratio=ratio)
+        p = pave(x0, sep, eps, ratio=ratio, **kw)
         best = min(best, time.perf_counter() - t)
     assert p is not None
     return {"seconds": best, "boundary_boxes": len(p.boundary[0]), "undetermined_area": p.boundary_area,
@@ -47,13 +49,14 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3, help="best of N for ours")
     ap.add_argument("--ratio", type=float, default=0.49,
                     help="bisection ratio (default 0.49, codac's own cut, so both pavers build the same tree)")
+    ap.add_argument("--kappa", type=float, default=None, help="ours with cut='grid', max_volume=kappa*eps**2")
     args = ap.parse_args()
     worst = 0.0
     print(f"{'problem':8} {'eps':>6} | {'ours s':>8} {'boxes':>7} {'undet.':>9} | "
           f"{'codac s':>8} {'boxes':>7} {'undet.':>9} | ratio")  # fmt: skip
     for name in args.problems:
         for eps in args.eps:
-            a, c = ours(name, eps, args.repeat, args.ratio), codac("pave", name, eps)
+            a, c = ours(name, eps, args.repeat, args.ratio, args.kappa), codac("pave", name, eps)
             ratio = a["seconds"] / c["seconds"]
             worst = max(worst, ratio)
             print(f"{name:8} {eps:6g} | {a['seconds']:8.4f} {a['boundary_boxes']:7d} {a['undetermined_area']:9.5f} | "
