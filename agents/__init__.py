@@ -12,6 +12,10 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+from . import origin as _origin
+
+_origin.warn_if_shadowed(__name__)
+
 #: Public names and the submodule that defines each.
 _LAZY = {
     "BASELINES": "baselines",

@@ -3,8 +3,10 @@
 :func:`evaluate` runs every agent on the same maps and seeds (map ``i`` is ``reset(seed=seed + i)`` with the
 world regenerated at each reset, ``fixed_world=False``) and records, after each step, the certified coverage
 (the guaranteed observer's claim, ``info["certified_coverage"]``) and the ground-truth coverage
-(``info["true_coverage"]``), padded with the last value once the episode ends; plus the collisions
-(``info["bumps"]``) and the final tube width (widest side of the pose box, m). Policies are objects with
+(``info["true_coverage"]``), both shares of the same area, the reachable free area (free cells connected to
+the start, :func:`digslam.envs.observer_wrapper.reachable_free`), so certified <= ground truth; padded
+with the last value once the episode ends; plus the collisions (``info["bumps"]``) and the final tube
+width (widest side of the pose box, m). Policies are objects with
 ``predict(obs, state=None, episode_start=None, deterministic=True)``: the baselines of :mod:`.baselines` or
 stable-baselines3 models.
 
@@ -212,34 +214,52 @@ def evaluate(
     return EvalResult(out["c"], out["t"], out["b"], out["w"], out["n"], env_id, seed, n_maps)
 
 
-def coverage_figure(result: EvalResult, path: str | Path) -> Path:
-    """Certified (solid) and ground-truth (dashed) coverage against steps, mean ± std bands (matplotlib,
-    Agg); returns the path written."""
+def coverage_figure(result: EvalResult, path: str | Path, target: float | None = None) -> Path:
+    """Certified (solid) and ground-truth (dashed) coverage against steps, both shares of the reachable free
+    area, mean ± std bands (matplotlib, Agg); returns the path written.
+
+    ``target`` (the environment's, e.g. 0.8) is drawn as a dotted line; an episode that ended early is drawn
+    up to its end and marked there (x); agents with identical curves stay visible (each has its own
+    marker, offset along the curve, and the earlier ones are drawn wider); the legend sits outside the axes.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7.0, 4.2), dpi=120)
+    fig, ax = plt.subplots(figsize=(8.8, 4.2), dpi=120)
+    n_agents, markers = len(result.curves), "osD^vP*"
     for k, (name, c) in enumerate(result.curves.items()):
-        colour = f"C{k}"
-        x = np.arange(c.shape[1])
+        colour, lw = f"C{k}", 1.4 + 1.6 * (n_agents - 1 - k)  # wider first: identical curves stay visible
+        lengths = np.asarray(result.lengths.get(name, np.full(c.shape[0], c.shape[1] - 1)), dtype=np.int64)
+        end = int(lengths.max()) if c.shape[0] == 1 else c.shape[1] - 1  # one episode: drawn to its end
+        x = np.arange(end + 1)
+        every = max((end + 1) // 8, 1)
         for curves, style, alpha in ((c, "-", 0.2), (result.true_curves[name], "--", 0.08)):
-            mu, sd = curves.mean(axis=0), curves.std(axis=0)
+            mu, sd = curves.mean(axis=0)[: end + 1], curves.std(axis=0)[: end + 1]
             label = name if style == "-" else None
-            ax.plot(x, mu, style, color=colour, lw=1.6, label=label)
+            ax.plot(x, mu, style, color=colour, lw=lw, label=label, marker=markers[k % len(markers)],
+                    markevery=(k * every // max(n_agents, 1), every), ms=5)  # fmt: skip
             lo, hi = np.clip(mu - sd, 0, 1), np.clip(mu + sd, 0, 1)
             ax.fill_between(x, lo, hi, color=colour, alpha=alpha, lw=0)
-    ax.plot([], [], "k-", label="certified")
-    ax.plot([], [], "k--", label="ground truth")
+        early = lengths < c.shape[1] - 1
+        if early.any():  # episodes that ended (target reached or claims withdrawn) before the last step
+            ax.plot(lengths[early], c[early, lengths[early]], "x", color=colour, ms=9, mew=2)
+    if any((np.asarray(v) < result.n_steps).any() for v in result.lengths.values()):
+        ax.plot([], [], "kx", ms=8, mew=2, label="episode ended")
+    if target is not None:
+        ax.axhline(target, color="0.35", lw=1.2, ls=":", label=f"target {target:.2f} (the episode ends)")
+    ax.plot([], [], "k-", label="certified (proved free and sensed)")
+    ax.plot([], [], "k--", label="ground truth (truly sensed)")
     ax.set_xlabel("steps")
-    ax.set_ylabel("coverage of the reachable free area")
+    ax.set_ylabel("share of the reachable free area")
     ax.set_ylim(0, 1)
     ax.set_xlim(0, max(result.n_steps, 1))
     n = next(iter(result.curves.values())).shape[0] if result.curves else 0
-    ax.set_title(f"{result.env_id or 'coverage'}: mean ± std over {n} map(s)")
+    over = "1 episode" if n == 1 else f"mean ± std over {n} episodes (one per map)"
+    ax.set_title(f"{result.env_id or 'coverage'}: coverage of the reachable free area, {over}", fontsize=9)
     ax.grid(alpha=0.3)
-    ax.legend(loc="lower right", fontsize=8)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=8)
     fig.tight_layout()
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
@@ -257,38 +277,14 @@ def record_episode_gif(
     env_kwargs: dict[str, Any] | None = None,
     fps: int = 15,
     stride: int = 1,
-    scale: int = 2,
+    scale: int = 1,
 ) -> Path:
-    """Animated GIF (imageio) of ``env.render()`` (the thesis colours: clear red, penumbra orange, dark
-    blue, obstacles grey, pose box black, true robot green) over one episode of ``policy``.
+    """Animated GIF of one episode of ``policy``: the frames of :mod:`.pictures` (the observer's sets in a
+    colour-blind-safe palette, a legend in the thesis's words, the step, both coverages and the tube width;
+    :func:`~.pictures.demo_episode`). ``stride`` keeps every ``stride``-th frame and ``scale`` shrinks
+    each frame by that factor (file size)."""
+    from .pictures import demo_episode
 
-    ``stride`` keeps every ``stride``-th frame and ``scale`` shrinks each frame by that factor (file size).
-    """
-    import imageio.v2 as imageio
-
-    for name, v in (("steps", steps), ("fps", fps), ("stride", stride), ("scale", scale)):
-        if not (isinstance(v, int) and v >= 1):
-            raise ValueError(f"{name}: must be an integer >= 1, got {v!r}")
-    env = _make_env(env_id, steps, env_kwargs, render=True)
-    p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    if hasattr(policy, "reset") and callable(policy.reset) and not hasattr(policy, "policy"):
-        policy.reset()
-    try:
-        obs, _ = env.reset(seed=seed)
-        with imageio.get_writer(p, mode="I", duration=1000.0 / fps, loop=0) as w:
-            w.append_data(env.render()[::scale, ::scale])
-            state, start = None, np.ones(1, dtype=bool)
-            for n in range(1, steps + 1):
-                action, state = policy.predict(obs, state=state, episode_start=start, deterministic=True)
-                start = np.zeros(1, dtype=bool)
-                action = np.clip(np.asarray(action, dtype=np.float32).reshape(env.action_space.shape), -1, 1)
-                obs, _, terminated, truncated, _ = env.step(action)
-                last = terminated or truncated or n == steps
-                if n % stride == 0 or last:
-                    w.append_data(env.render()[::scale, ::scale])
-                if terminated or truncated:
-                    break
-    finally:
-        env.close()
-    return p
+    demo_episode(policy, env_id, path, steps=steps, seed=seed, env_kwargs=env_kwargs, fps=fps, stride=stride,
+                 scale=scale)  # fmt: skip
+    return Path(path)

@@ -138,12 +138,15 @@ class TrainConfig:
         p = Path(path) if path is not None else DEFAULT_CONFIG
         if not p.is_file():
             raise ValueError(f"path: no configuration file {str(p)!r}")
-        if p.suffix == ".json":
-            data = json.loads(p.read_text())
-        elif p.suffix == ".toml":
-            data = tomllib.loads(p.read_text())
-        else:
+        if p.suffix not in (".json", ".toml"):
             raise ValueError(f"path: configuration must be .toml or .json, got {str(p)!r}")
+        try:
+            text = p.read_text()
+            data = json.loads(text) if p.suffix == ".json" else tomllib.loads(text)
+        except (OSError, UnicodeDecodeError, ValueError) as exc:  # TOMLDecodeError, JSONDecodeError
+            raise ValueError(f"path: cannot read {str(p)!r} as {p.suffix[1:].upper()} ({exc})") from None
+        if not isinstance(data, dict):
+            raise ValueError(f"path: {str(p)!r} must hold a table of settings, got {type(data).__name__}")
         return cls.from_dict(data).override(overrides)
 
     def override(self, overrides: Iterable[str]) -> TrainConfig:
@@ -263,11 +266,21 @@ def build_model(cfg: TrainConfig, env: Any, tensorboard_log: str | None = None) 
     )
 
 
-def train(cfg: TrainConfig, callbacks: Sequence[Any] = ()) -> Path:
+class TrainingInterrupted(KeyboardInterrupt):
+    """Ctrl-C during :func:`train`: the model so far was saved to ``path`` after ``timesteps`` steps."""
+
+    def __init__(self, path: Path, timesteps: int) -> None:
+        super().__init__(f"interrupted after {timesteps} timesteps; saved {path}")
+        self.path, self.timesteps = path, timesteps
+
+
+def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = None) -> Path:
     """Train PPO as ``cfg`` says; returns the saved final model (``<out_dir>/final_model.zip``).
 
     ``callbacks`` are extra SB3 callbacks given to ``learn`` (e.g. the Ray Tune reporter of
-    :mod:`.sweep`).
+    :mod:`.sweep`). ``worker_guard`` is a context manager held while the worker processes start (the
+    command line's ignores SIGINT there, so Ctrl-C reaches the main process only). Ctrl-C during ``learn``
+    saves the model so far to ``<out_dir>/interrupted_model.zip`` and raises :class:`TrainingInterrupted`.
 
     ``out_dir`` also gets ``config.json``, ``checkpoints/``, ``tb/`` (TensorBoard), and with evaluation
     ``best_model.zip`` and ``eval/evaluations.npz`` (held-out maps ``cfg.eval_seeds()``).
@@ -284,7 +297,10 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = ()) -> Path:
         tb: str | None = str(out / "tb")
     except ImportError:
         tb = None
-    env = make_vec_env(EnvFactory(cfg.env_id, cfg.env_kwargs, cfg.torch_threads), cfg.n_envs, cfg.seed)
+    import contextlib
+
+    with worker_guard if worker_guard is not None else contextlib.nullcontext():
+        env = make_vec_env(EnvFactory(cfg.env_id, cfg.env_kwargs, cfg.torch_threads), cfg.n_envs, cfg.seed)
     callbacks = list(callbacks)
     eval_env = None
     try:
@@ -310,14 +326,29 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = ()) -> Path:
         bar = _has_progress() and cfg.progress_bar
         with warnings.catch_warnings():  # Subproc training env vs Dummy eval env is intended
             warnings.filterwarnings("ignore", message="Training and eval env are not of the same type")
-            model.learn(cfg.total_timesteps, callback=callbacks, progress_bar=bar)
+            try:
+                model.learn(cfg.total_timesteps, callback=callbacks, progress_bar=bar)
+            except KeyboardInterrupt:
+                path = out / "interrupted_model.zip"
+                _save(model, path)
+                raise TrainingInterrupted(path, int(model.num_timesteps)) from None
         path = out / "final_model.zip"
-        model.save(path)
+        _save(model, path)
     finally:
         env.close()
         if eval_env is not None:
             eval_env.close()
     return path
+
+
+def _save(model: Any, path: Path) -> None:
+    """``model.save`` to a scratch file, then renamed: an interrupted save leaves no half-written model."""
+    tmp = path.with_name(f".{path.stem}.part{os.getpid()}.zip")
+    try:
+        model.save(tmp)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 def _has_progress() -> bool:
@@ -329,5 +360,5 @@ def _has_progress() -> bool:
     return True
 
 
-__all__ = ["DEFAULT_CONFIG", "EnvFactory", "SeedCycle", "TrainConfig", "build_model", "make_vec_env",
-           "parse_value", "pin_threads", "train"]  # fmt: skip
+__all__ = ["DEFAULT_CONFIG", "EnvFactory", "SeedCycle", "TrainConfig", "TrainingInterrupted", "build_model",
+           "make_vec_env", "parse_value", "pin_threads", "train"]  # fmt: skip

@@ -2,7 +2,9 @@
 
 Importing this package registers ``digslam/Explore-v0`` (the thesis room of Fig. 6.10) and its variants
 (:data:`ENV_IDS`), and the certified-coverage ``digslam/DigCoverage-v0`` and its variants
-(:data:`COVERAGE_IDS`: omni-only, sonar-only, large caves, adversarial noise). In worker processes that
+(:data:`COVERAGE_IDS`: omni-only, sonar-only, large caves, adversarial noise, and unflagged outliers, at most
+one per step, under the observer's q-relaxed mode with ``q = 1``; ``ExploreOutliers-v0`` caps its outliers
+at one per step too). In worker processes that
 have not imported it (e.g. SB3's ``SubprocVecEnv`` with forkserver), use the
 ``"digslam.envs:digslam/Explore-v0"`` form, which imports the module first.
 """
@@ -11,12 +13,16 @@ from __future__ import annotations
 
 import gymnasium as gym
 
+from digslam.agents import origin as _origin  # a shadowing source folder is reported in one line
+
 from .config import ExploreConfig, NoiseConfig
 from .episode import Episode, GroundTruth, record_episode, replay
 from .explore_env import ExploreEnv
 from .generators import Caves, FileMap, RockField, RoomsCorridors, ThesisRoom, WorldGenerator
 from .sensors import SensorSuite
 from .world import World
+
+_origin.warn_if_shadowed(__name__)
 
 MAX_EPISODE_STEPS = 1000
 
@@ -27,7 +33,7 @@ ENV_IDS: dict[str, dict[str, object]] = {
     "digslam/ExploreCaves-v0": {"world": "caves"},
     "digslam/ExploreRooms-v0": {"world": "rooms"},
     "digslam/ExploreAdversarial-v0": {"noise": {"model": "adversarial"}},
-    "digslam/ExploreOutliers-v0": {"world": "rocks", "noise": {"outlier_prob": 0.05}},
+    "digslam/ExploreOutliers-v0": {"world": "rocks", "noise": {"outlier_prob": 0.05, "max_outliers": 1}},
 }
 
 #: Certified-coverage ids (``DigCoverageEnv``: the raw env under the guaranteed observer) and their kwargs.
@@ -37,6 +43,8 @@ COVERAGE_IDS: dict[str, dict[str, object]] = {
     "digslam/DigCoverageSonar-v0": {"omni": False},
     "digslam/DigCoverageCaves-v0": {"world": "caves", "world_size": 20.0},
     "digslam/DigCoverageAdversarial-v0": {"noise": {"model": "adversarial"}},
+    "digslam/DigCoverageOutliers-v0": {"world": "rocks", "noise": {"outlier_prob": 0.05, "max_outliers": 1},
+                                       "q": 1},  # fmt: skip
 }
 
 for _ids, _entry in (

@@ -82,6 +82,9 @@ class NoiseConfig(_Config):
             ``biased`` (error ``bias * bound`` plus uniform jitter, always inside the bounds).
         bias: Bias as a fraction of the bound, in [-1, 1] (``biased`` model only).
         outlier_prob: Probability that a range reading is an outlier (flagged in the record).
+        max_outliers: At most this many outliers per step (an integer >= 0; None: no cap). With
+            ``max_outliers = q`` the premise of the observer's q-relaxed mode (``q`` outliers per step at
+            most, :class:`~digslam.observer.online.OnlineConfig`) holds exactly.
     """
 
     speed: float = 0.001
@@ -91,6 +94,7 @@ class NoiseConfig(_Config):
     model: str = "uniform"
     bias: float = 0.5
     outlier_prob: float = 0.0
+    max_outliers: int | None = None
 
     def __post_init__(self) -> None:
         for name in ("speed", "yaw_rate", "heading", "range"):
@@ -103,6 +107,12 @@ class NoiseConfig(_Config):
             0.0 <= self.outlier_prob <= 1.0,
             "noise.outlier_prob",
             f"must be in [0, 1], got {self.outlier_prob!r}",
+        )
+        m = self.max_outliers
+        _check(
+            m is None or (isinstance(m, int) and not isinstance(m, bool) and m >= 0),
+            "noise.max_outliers",
+            f"must be None or an integer >= 0, got {m!r}",
         )
 
 

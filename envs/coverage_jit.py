@@ -1,4 +1,5 @@
-"""Compiled kernel of the ground-truth coverage (the reward of ``digslam/Explore-v0``, see :mod:`.coverage`).
+"""Compiled kernel of the ground-truth coverage (:mod:`.coverage`: the reward of ``digslam/Explore-v0``, and
+the ground truth the certified coverage is compared with, over the reachable free area).
 
 The sensed radius is a step function of the world bearing: on each angular interval between cone edges,
 the largest reach of the cones covering it. :func:`cover_kernel` turns the interval bounds into world
@@ -92,8 +93,9 @@ def cover_kernel(free: np.ndarray, seen: np.ndarray, xs: np.ndarray, ys: np.ndar
             c += 1
         tab[q] = (c_lo - 1 if c_lo > 0 else B - 1) if c == c_lo else -2  # c_lo = #(ws <= q / 64)
         c_lo = c
-    res = (xs[xs.shape[0] - 1] - xs[0]) / max(xs.shape[0] - 1, 1)
-    w = (free, seen, xs, ys, i0, i1, j0, j1, x, y, res)
+    resx = (xs[xs.shape[0] - 1] - xs[0]) / (xs.shape[0] - 1) if xs.shape[0] > 1 else math.inf  # one column:
+    resy = (ys[ys.shape[0] - 1] - ys[0]) / (ys.shape[0] - 1) if ys.shape[0] > 1 else math.inf  # no cut needed
+    w = (free, seen, xs, ys, i0, i1, j0, j1, x, y, resx, resy)
     # Cells nearer than the smallest radius are sensed whatever their bearing.
     rm = math.sqrt(r2min)
     count = _scan(w, -rm, rm, -rm, rm, r2min, -1, r2min, ws, tab, B)
@@ -127,11 +129,11 @@ def _scan(w: tuple, xlo: float, xhi: float, ylo: float, yhi: float, r2b: float, 
     """Mark the free, unseen cells of the box ``[xlo, xhi] x [ylo, yhi]`` (relative to the pose, widened by
     two cells) closer than ``sqrt(r2b)``: all of them if ``b < 0``, else those of bearing interval ``b``
     beyond ``sqrt(r2min)``."""
-    free, seen, xs, ys, i0, i1, j0, j1, x, y, res = w
-    ia = max(i0, int(math.floor((y + ylo - ys[0]) / res)) - 2)
-    ib = min(i1, int(math.floor((y + yhi - ys[0]) / res)) + 3)
-    ja = max(j0, int(math.floor((x + xlo - xs[0]) / res)) - 2)
-    jb = min(j1, int(math.floor((x + xhi - xs[0]) / res)) + 3)
+    free, seen, xs, ys, i0, i1, j0, j1, x, y, resx, resy = w
+    ia = max(i0, int(math.floor((y + ylo - ys[0]) / resy)) - 2)
+    ib = min(i1, int(math.floor((y + yhi - ys[0]) / resy)) + 3)
+    ja = max(j0, int(math.floor((x + xlo - xs[0]) / resx)) - 2)
+    jb = min(j1, int(math.floor((x + xhi - xs[0]) / resx)) + 3)
     count = 0
     for i in range(ia, ib):
         vy = ys[i] - y
@@ -161,3 +163,19 @@ def _scan(w: tuple, xlo: float, xhi: float, ylo: float, yhi: float, r2b: float, 
             seen[i, j] = True
             count += 1
     return count
+
+
+@njit
+def cover_update(free: np.ndarray, seen: np.ndarray, xs: np.ndarray, ys: np.ndarray, win: np.ndarray,
+                 pose: np.ndarray, breaks: np.ndarray, cover: np.ndarray, ranges: np.ndarray,
+                 r_max: np.ndarray) -> int:  # fmt: skip
+    """:func:`cover_kernel` on the window of cells within reach of ``pose`` ``(x, y, theta)``: ``win`` is
+    ``(x0, y0, dx, dy, kx, ky)``, the grid's lower-left corner, its cell sides and the reach in cells; the
+    window is the ``(2 ky + 1) x (2 kx + 1)`` cells around the pose's cell (one call per step, no Python
+    arithmetic)."""
+    x, y, th = pose[0], pose[1], pose[2]
+    ny, nx = free.shape
+    kx, ky = int(win[4]), int(win[5])
+    ic, jc = int(math.floor((y - win[1]) / win[3])), int(math.floor((x - win[0]) / win[2]))
+    i0, i1, j0, j1 = max(ic - ky, 0), min(ic + ky + 1, ny), max(jc - kx, 0), min(jc + kx + 1, nx)
+    return cover_kernel(free, seen, xs, ys, i0, i1, j0, j1, x, y, th, breaks, cover, ranges, r_max)

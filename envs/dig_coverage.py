@@ -11,6 +11,11 @@ The raw :class:`~.explore_env.ExploreEnv` under a :class:`~.observer_wrapper.Gua
 * ``render``: the thesis colours (clear red, penumbra orange, dark blue; obstacles grey) with the pose box
   (black) and the true robot (green).
 
+``digslam/DigCoverageOutliers-v0`` is this env on the rocks world with unflagged outliers, at most one per
+step (``noise.max_outliers = 1``), and the observer's q-relaxed mode at ``q = 1`` (thesis §2.6.2): no false
+claim from that one bad reading (see :mod:`.observer_wrapper` for what is claimed when the data break
+their bounds).
+
 Keyword arguments are routed by :meth:`~.observer_config.DigCoverageConfig.split`: coverage keys, observer
 keys, then raw-env keys (unknown keys raise ``ValueError``).
 

@@ -26,6 +26,12 @@ class GroundTruth:
         ranges: True range per sensor (m), ``inf`` where no echo.
         bumps: New wall contacts during the step.
         bumps_total: Wall contacts since reset.
+        pieces: The step's motion ``(2, 3)``, rows ``(v, tau, theta_end)`` (:mod:`.arc`): over each piece
+            the speed is ``v`` and the heading moves linearly to ``theta_end`` from the previous piece's
+            (or the previous step's); the taus sum exactly to the time since the previous record. At reset
+            the robot is at rest (taus 0).
+        pose_error: Proved bound on ``max(|x - x_true|, |y - y_true|)`` of ``pose``, where the true
+            position is the exact chain of arcs of ``pieces`` from the reset pose; ``pose[2]`` is exact.
     """
 
     t: np.ndarray
@@ -35,24 +41,34 @@ class GroundTruth:
     ranges: np.ndarray
     bumps: np.ndarray
     bumps_total: np.ndarray
+    pieces: np.ndarray | None = None
+    pose_error: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         d = self.__dict__
-        for name in ("t", "pose", "speed", "yaw_rate", "ranges"):
+        lead = np.shape(d["t"])
+        if d["pieces"] is None:  # an episode saved before pieces were recorded: unknown motion
+            d["pieces"] = np.full(lead + (2, 3), np.nan)
+        if d["pose_error"] is None:
+            d["pose_error"] = np.full(lead, np.nan)
+        for name in ("t", "pose", "speed", "yaw_rate", "ranges", "pieces", "pose_error"):
             d[name] = np.asarray(d[name], dtype=np.float64)
         d["bumps"] = np.asarray(d["bumps"], dtype=np.int64)
         d["bumps_total"] = np.asarray(d["bumps_total"], dtype=np.int64)
 
     @classmethod
     def of_step(cls, t: float, pose: np.ndarray, speed: float, yaw_rate: float, ranges: np.ndarray,
-                bumps: int, bumps_total: int) -> GroundTruth:  # fmt: skip
-        """The same object as ``GroundTruth(...)`` for a float64 ``pose (3,)`` and ``ranges (n,)`` the caller
-        hands over, with the scalars as 0-d views of two small arrays: the env's per-step constructor."""
-        f = np.array([t, speed, yaw_rate], dtype=np.float64)
+                bumps: int, bumps_total: int, pieces: np.ndarray,
+                pose_error: float) -> GroundTruth:  # fmt: skip
+        """The same object as ``GroundTruth(...)`` for a float64 ``pose (3,)``, ``ranges (n,)`` and
+        ``pieces (2, 3)`` the caller hands over, with the scalars as 0-d views of two small arrays: the env's
+        per-step constructor."""
+        f = np.array([t, speed, yaw_rate, pose_error], dtype=np.float64)
         i = np.array([bumps, bumps_total], dtype=np.int64)
         g = cls.__new__(cls)
         g.__dict__.update(t=f[..., 0], pose=pose, speed=f[..., 1], yaw_rate=f[..., 2], ranges=ranges,
-                          bumps=i[..., 0], bumps_total=i[..., 1])  # fmt: skip
+                          bumps=i[..., 0], bumps_total=i[..., 1], pieces=pieces,
+                          pose_error=f[..., 3])  # fmt: skip
         return g
 
     def as_dict(self) -> dict[str, np.ndarray]:
@@ -107,7 +123,7 @@ class Episode:
         cfg: dict[str, Any] = json.loads(str(data["config"]))
         if cfg.get("start") is not None:
             cfg["start"] = tuple(cfg["start"])
-        truth = GroundTruth(**{f.name: data["truth_" + f.name] for f in fields(GroundTruth)})
+        truth = GroundTruth(**{f.name: data.get("truth_" + f.name) for f in fields(GroundTruth)})
         return Episode(
             ExploreConfig.from_dict(cfg),
             int(data["seed"]),

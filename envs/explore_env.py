@@ -16,8 +16,11 @@ Record convention (record ``j`` is the one returned at time ``t_j``; ``j = 0`` b
   record 0 carries the robot at rest, ``[0, 0]`` widened by the noise bound.
 
 This is the data contract of :mod:`digslam.observer.record`, which the observers (offline ``dig_slam``,
-the online filter of :mod:`.observer_wrapper`) read as it is. Every bound is widened by
-:data:`~.sensors.SIM_TOL` for the simulator's own rounding.
+the online filter of :mod:`.observer_wrapper`) read as it is. Every bound contains the exact truth,
+floating point included: the truth is the chain of exact arcs of :mod:`.arc` (the stored heading is exact,
+the stored position within the proved ``truth.pose_error``), the odometry hulls are the pieces' exact speeds
+and outward-rounded yaw rates, and the ranges are rigorous bounds around the true pose
+(:meth:`~.sensors.SensorSuite.range_bounds`). Each step lasts exactly the time between its two records.
 """
 
 from __future__ import annotations
@@ -32,13 +35,14 @@ from gymnasium import spaces
 
 from digslam.observer.record import MissionRecord
 
+from .arc import exact_duration
 from .config import ExploreConfig
 from .coverage import Coverage
 from .episode import GroundTruth
 from .generators import GENERATORS, WorldGenerator
 from .noise_jit import obs_kernel
 from .robot import RobotSim
-from .sensors import SIM_TOL, SensorSuite, measure_step
+from .sensors import SensorSuite, measure_step
 from .world import World
 
 
@@ -102,10 +106,6 @@ class ExploreEnv(gym.Env):
         self._odo_tops = (float(self._odo_top[0, 0]), float(self._odo_top[1, 0]))
         hb = self.observation_space["heading"]
         self._heading_box = (float(hb.low[0]), float(hb.high[0]))
-        #: Build the raw observation in :meth:`step` (default True). The observer wrapper, which hands its
-        #: own observation to the agent and never reads this one, sets it False: ``step`` then returns None
-        #: as its observation and everything else unchanged (``reset`` always builds it).
-        self.raw_observation = True
         self.world: World | None = None
         self.sim: RobotSim | None = None
         self.coverage: Coverage | None = None
@@ -140,19 +140,28 @@ class ExploreEnv(gym.Env):
         return self._obs(record), self._info(record, truth)
 
     def step(self, action: np.ndarray) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        return self._step(action)
+
+    def _step(
+        self, action: np.ndarray, observe: bool = True
+    ) -> tuple[dict[str, np.ndarray] | None, float, bool, bool, dict[str, Any]]:
+        """:meth:`step`; with ``observe=False`` the raw observation is not built and None stands in its place
+        (the internal fast path of the observer wrapper, which hands the agent its own observation)."""
         if self.sim is None:
             raise RuntimeError("step: call reset() before step()")
         a = self._check_action(action)
         cfg = self.config
-        bumps = self.sim.step(a[0] * cfg.max_speed, a[1] * cfg.max_yaw_rate, cfg.dt, cfg.substeps)
-        self.t += cfg.dt
+        t1 = self.t + cfg.dt
+        bumps = self.sim.step(a[0] * cfg.max_speed, a[1] * cfg.max_yaw_rate, exact_duration(self.t, t1),
+                              cfg.substeps)  # fmt: skip
+        self.t = t1
         record, truth = self._sense(bumps)
         self.path.append(truth.pose[:2].copy())
         self._last = record
         reward = self._reward(truth)
         if self.render_mode == "human":
             self.render()
-        obs = self._obs(record) if self.raw_observation else None
+        obs = self._obs(record) if observe else None
         return obs, reward, self._terminated(), False, self._info(record, truth)
 
     def render(self) -> np.ndarray | None:
@@ -184,21 +193,14 @@ class ExploreEnv(gym.Env):
 
     def _sense(self, bumps: int) -> tuple[MissionRecord, GroundTruth]:
         assert self.sim is not None and self.world is not None
-        pose = self.sim.pose
+        sim = self.sim
+        pose = sim.pose
         ranges = self.suite.true_ranges(self.world, pose)
-        speed, yaw = self.sim.speed, self.sim.yaw_rate
-        record = measure_step(
-            self.t,
-            self.suite,
-            ranges,
-            self.sim.speed_hull,
-            self.sim.yaw_hull,
-            pose[2],
-            self.config.noise,
-            self.np_random,
-            tol=SIM_TOL,
-        )
-        truth = GroundTruth.of_step(self.t, pose, speed, yaw, ranges, bumps, self.sim.bumps)
+        bounds = self.suite.range_bounds(self.world, pose, sim.pose_error)
+        record = measure_step(self.t, self.suite, bounds, sim.speed_hull, sim.yaw_hull, pose[2],
+                              self.config.noise, self.np_random)  # fmt: skip
+        truth = GroundTruth.of_step(self.t, pose, sim.speed, sim.yaw_rate, ranges, bumps, sim.bumps,
+                                    sim.pieces.copy(), sim.pose_error)  # fmt: skip
         return record, truth
 
     def _reward(self, truth: GroundTruth) -> float:

@@ -11,11 +11,12 @@ its heading moves linearly from ``ψ_k`` to ``ψ_{k+1}``. The records follow the
 * ``range[k]`` bounds the exact sonar / omnidirectional distances (:class:`~.sensors.SensorSuite`) at
   the true pose ``k``.
 
-The truth is computed in float64: each arc is evaluated from the stored pose over the exact duration
-``t_{k+1} - t_k`` of the recorded times, and its own rounding (a few ulps per step, never accumulated
-because every step restarts from the stored pose) is covered by widening every interval by
-:data:`~.sensors.SIM_TOL` (relative, at least absolute). Under ``adversarial`` noise the truth therefore
-lies within ``SIM_TOL`` of a bound rather than exactly on it.
+The truth is the chain of exact arcs of :mod:`.arc` (one function for the whole project): each slice lasts
+exactly ``t_{k+1} - t_k`` (consecutive float times), its heading ``fl(ψ_k + ω τ)`` is the true heading, and
+the position carries the proved, accumulated error bound of :func:`.arc.arc_move`. The records contain the
+exact truth, floating point included: the speed is exact, the yaw rate is outward-rounded
+(:func:`.arc.yaw_rate_bounds`) and the ranges are rigorous bounds around the true pose
+(:meth:`~.sensors.SensorSuite.range_bounds`); no tolerance is chosen by hand.
 
 >>> rec, truth = loop_mission(duration=2.0, seed=0)
 >>> len(rec), truth.shape, bool(np.all(rec.range[:, 0, 0] <= rec.range[:, 0, 1]))
@@ -30,9 +31,10 @@ import numpy as np
 
 from digslam.observer.record import MissionRecord
 
+from .arc import arc, arc_bounded, exact_duration, yaw_rate_bounds
 from .config import NoiseConfig
 from .generators import ThesisRoom
-from .sensors import SIM_TOL, SensorSuite, measure_step
+from .sensors import SensorSuite, measure_step
 from .world import World
 
 #: A loop of waypoints inside the thesis room of Fig. 6.10 (at least 1.3 m from every wall).
@@ -40,16 +42,6 @@ THESIS_LOOP = np.array(
     [(0.0, 0.0), (3.0, -5.5), (6.5, -5.0), (5.0, -1.0), (4.0, 2.5), (6.5, 5.5), (4.0, 6.5), (0.5, 2.0),
      (-3.0, 5.5), (-6.5, 5.5), (-5.5, 2.5), (-2.5, 0.5), (-6.5, -3.5), (-6.0, -6.5), (-2.0, -5.0)]
 )  # fmt: skip
-
-
-def arc(pose: np.ndarray, v: float, w: float, dt: float) -> np.ndarray:
-    """Exact unicycle motion with constant ``(v, ω)`` over ``dt``."""
-    x, y, th = pose
-    if abs(w) < 1e-12:
-        return np.array([x + v * dt * math.cos(th), y + v * dt * math.sin(th), th])
-    th2 = th + w * dt
-    k = v / w
-    return np.array([x + k * (math.sin(th2) - math.sin(th)), y - k * (math.cos(th2) - math.cos(th)), th2])
 
 
 def loop_mission(
@@ -98,7 +90,8 @@ def loop_mission(
     d0 = wp[1] - wp[0]
     pose = np.array([wp[0, 0], wp[0, 1], math.atan2(d0[1], d0[0])])
     target, records, truth = 1, [], []
-    odo = (0.0, 0.0)  # record 0: at rest
+    odo: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))  # record 0: at rest
+    pose_error = 0.0
     for k in range(n + 1):
         to = wp[target] - pose[:2]
         if np.hypot(*to) < 0.6:
@@ -107,11 +100,13 @@ def loop_mission(
         err = (math.atan2(to[1], to[0]) - pose[2] + math.pi) % (2 * math.pi) - math.pi
         w = float(np.clip(1.5 * err, -max_yaw_rate, max_yaw_rate))
         v = speed * max(0.2, math.cos(err))
-        ranges = suite.true_ranges(world, pose)
-        records.append(measure_step(k * dt, suite, ranges, *odo, float(pose[2]), noise, rng, tol=SIM_TOL))
+        bounds = suite.range_bounds(world, pose, pose_error)
+        records.append(measure_step(k * dt, suite, bounds, *odo, float(pose[2]), noise, rng))
         truth.append([*pose, v, w])
-        pose = arc(pose, v, w, (k + 1) * dt - k * dt)
-        odo = (v, w)  # bounded by the next record: the slice that ends there
+        nxt, err = arc_bounded(pose, v, w, exact_duration(k * dt, (k + 1) * dt))
+        pose_error = math.nextafter(pose_error + err, math.inf)
+        odo = ((v, v), yaw_rate_bounds(float(pose[2]), float(nxt[2]), (k + 1) * dt - k * dt))
+        pose = nxt  # odo is bounded by the next record: the slice that ends there
     return MissionRecord.stack(records), np.array(truth)
 
 

@@ -8,7 +8,10 @@ record and truth:
 2. no clear cell contains an obstacle point: each newly clear cell is checked exactly against the world's
    edges (its centre is free and no edge meets the closed cell box, a closed-slab segment test);
 3. every truly sensed point lies in clear ∪ penumbra: points drawn in each true sector (below the true range,
-   or ``r_max`` without echo) must not fall in a dark cell.
+   or ``r_max`` without echo) must not fall in a dark cell;
+4. (when given the wrapper's ``coverage``) certified coverage never exceeds ground-truth coverage: both are
+   counts of cells of the same reachable free area (:func:`.observer_wrapper.reachable_free`), the clear
+   ones against those whose centre was truly sensed (:meth:`.coverage.Coverage.on_cells`).
 
 Once the filter reports an inconsistency its claims are withdrawn, so nothing more is checked.
 
@@ -67,10 +70,13 @@ class GuaranteeMonitor:
     Args:
         world: the ground truth.
         grid: the observer's grid.
+        coverage: ``(reachable, truth)``: the reachable free cells ``(ny, nx)`` (row 0 at the top) and the
+            ground-truth :class:`~.coverage.Coverage` over them, updated before each :meth:`check`; then
+            claim 4 is checked too.
     """
 
-    def __init__(self, world: World, grid: Grid) -> None:
-        self.world, self.grid = world, grid
+    def __init__(self, world: World, grid: Grid, coverage: tuple[np.ndarray, Any] | None = None) -> None:
+        self.world, self.grid, self.coverage = world, grid, coverage
         self.checked = np.zeros(grid.shape, dtype=bool)
         self.rng = np.random.default_rng(0)
         self.violations = 0
@@ -112,8 +118,12 @@ class GuaranteeMonitor:
 
         x, y, th = (float(v) for v in truth.pose)
         lo, hi = filt.pose_lo, filt.pose_hi
-        if not (lo[0] <= x <= hi[0] and lo[1] <= y <= hi[1]):
-            fail(f"true position {(x, y)} outside the pose box {lo.tolist()}..{hi.tolist()}")
+        # the true position is within truth.pose_error of the simulator's float one (its heading is exact):
+        # a float position farther than that from the box proves the true one outside it
+        e = float(getattr(truth, "pose_error", 0.0))
+        e = e if e >= 0.0 else 0.0  # NaN: an episode saved before the bound was recorded
+        if not (lo[0] - e <= x <= hi[0] + e and lo[1] - e <= y <= hi[1] + e):
+            fail(f"true position {(x, y)} (within {e:.1e}) outside the pose box {lo.tolist()}..{hi.tolist()}")
         if not (filt.heading_lo <= th <= filt.heading_hi):
             fail(f"true heading {th} outside [{filt.heading_lo}, {filt.heading_hi}]")
         clear = filt.clear_mask()
@@ -122,6 +132,15 @@ class GuaranteeMonitor:
         if len(bad):
             fail(f"clear cells {bad[:5].tolist()} contain an obstacle")
         self.checked |= new
+        if self.coverage is not None:
+            reach, cov = self.coverage
+            n_cert, n_true = int(np.count_nonzero(clear & reach)), int(cov.n_seen)
+            if n_cert > n_true:
+                fail(f"certified coverage ({n_cert} clear reachable cells) exceeds the ground truth "
+                     f"({n_true} reachable cells truly sensed) over the same area")  # fmt: skip
+            unseen = np.argwhere(clear & reach & ~cov.seen[::-1])
+            if len(unseen):
+                fail(f"clear cells {unseen[:5].tolist()}: their centres were never truly sensed")
         explored = filt.explored()
         pts = self.sensed_points(truth.pose, record, truth.ranges)
         g = self.grid

@@ -46,8 +46,25 @@ def outliers(
     r_max: np.ndarray,
     bound: float,
     rng: np.random.Generator,
+    max_count: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Outlier draws: ``(flag (n,), lo (n,), hi (n,))``, a spurious echo uniform in ``[0, r_max]``."""
-    flag = rng.uniform(0.0, 1.0, n) < prob
+    """Outlier draws: ``(flag (n,), lo (n,), hi (n,))``, a spurious echo uniform in ``[0, r_max]``.
+
+    Each reading is an outlier with probability ``prob``; with ``max_count``, at most that many per call (one
+    step): when more are drawn, the ``max_count`` with the smallest draws are kept (each reading alike).
+    The generator is advanced by ``2 n`` uniform draws whatever happens, so runs stay reproducible.
+
+    >>> f, lo, hi = outliers(9, 1.0, np.full(9, 5.0), 0.01, np.random.default_rng(0), max_count=1)
+    >>> int(f.sum()), bool(np.all(lo <= hi))
+    (1, True)
+    """
+    if max_count is not None and not (isinstance(max_count, int | np.integer) and max_count >= 0):
+        raise ValueError(f"max_count: must be None or an integer >= 0, got {max_count!r}")
+    u = rng.uniform(0.0, 1.0, n)
+    flag = u < prob
     m = rng.uniform(0.0, 1.0, n) * r_max
+    if max_count is not None and int(flag.sum()) > max_count:
+        keep = np.argsort(u, kind="stable")[:max_count]
+        flag = np.zeros(n, dtype=bool)
+        flag[keep] = True
     return flag, np.maximum(m - bound, 0.0), m + bound

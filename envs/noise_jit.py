@@ -69,18 +69,24 @@ def _pad(v: float, tol: float, sign: float) -> float:
 
 
 @njit
-def record_kernel(ranges: np.ndarray, r_max: np.ndarray, s_lo: float, s_hi: float, w_lo: float, w_hi: float,
-                  heading: float, b_speed: float, b_yaw: float, b_heading: float, b_range: float,
-                  u: np.ndarray, model: int, bias: float, flag: np.ndarray, o_lo: np.ndarray,
+def record_kernel(r_b: np.ndarray, r_max: np.ndarray, s_lo: float, s_hi: float,
+                  w_lo: float, w_hi: float, heading: float, b_speed: float, b_yaw: float, b_heading: float,
+                  b_range: float, u: np.ndarray, model: int, bias: float, flag: np.ndarray, o_lo: np.ndarray,
                   o_hi: np.ndarray, tol: float, out: np.ndarray, no_echo: np.ndarray) -> int:  # fmt: skip
     """Intervals of one step into ``out (n + 3, 2)`` (speed, yaw rate, heading, then ranges); ``no_echo``.
 
     ``s_lo, s_hi, w_lo, w_hi`` are the speed and yaw-rate hulls and ``heading`` the true heading;
-    ``b_*`` the noise bounds; ``u`` the ``n + 3`` uniform draws;
-    ``flag, o_lo, o_hi`` the outliers replacing range readings. Returns the first row whose interval has a
-    NaN or ``lo > hi`` (the checks of :class:`~digslam.observer.record.MissionRecord`), -1 if none.
+    ``r_b (n, 2)`` bounds each true sector distance (``[r, r]`` where it is known exactly; ``inf`` where
+    nothing lies in the sector); ``b_*`` the noise bounds; ``u`` the ``n + 3`` uniform draws;
+    ``flag, o_lo, o_hi`` the outliers replacing range readings. A hull ``[lo, hi]`` is reported as the noisy
+    interval of its midpoint widened by its half-width, so it contains the whole hull (under
+    ``adversarial`` noise the hull touches a bound). A reading is ``no_echo`` (``[r_max, inf]``) only when
+    the lower bound exceeds ``r_max``; one whose upper bound is not finite reads ``[min(lo, r_max), inf]``.
+    ``tol`` widens every finite bound by ``tol * max(1, |bound|)`` (0 when the truths are rigorous).
+    Returns the first row whose interval has a NaN or ``lo > hi`` (the checks of
+    :class:`~digslam.observer.record.MissionRecord`), -1 if none.
     """
-    n = ranges.shape[0]
+    n = r_b.shape[0]
     for k in range(2):
         h_lo, h_hi, b = (s_lo, s_hi, b_speed) if k == 0 else (w_lo, w_hi, b_yaw)
         half = 0.5 * (h_hi - h_lo)
@@ -88,9 +94,15 @@ def record_kernel(ranges: np.ndarray, r_max: np.ndarray, s_lo: float, s_hi: floa
         out[k, 0], out[k, 1] = min(lo - half, h_lo), max(hi + half, h_hi)  # exact containment of the hull
     _, out[2, 0], out[2, 1] = _one(heading, b_heading, u[2], model, bias)
     for s in range(n):
-        r = ranges[s]
-        no_echo[s] = not math.isfinite(r)
-        _, lo, hi = _one(0.0 if no_echo[s] else r, b_range, u[3 + s], model, bias)
+        a, z = r_b[s, 0], r_b[s, 1]
+        no_echo[s] = not a <= r_max[s]
+        if no_echo[s] or not math.isfinite(z):
+            _, lo, hi = _one(0.0 if no_echo[s] else a, b_range, u[3 + s], model, bias)
+            lo, hi = min(lo, r_max[s]), math.inf
+        else:
+            half = 0.5 * (z - a)
+            _, lo, hi = _one(0.5 * (a + z), b_range, u[3 + s], model, bias)
+            lo, hi = min(lo - half, a), max(hi + half, z)
         if flag[s]:
             out[3 + s, 0], out[3 + s, 1] = o_lo[s], o_hi[s]
             no_echo[s] = False

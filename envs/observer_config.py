@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import field
+from dataclasses import field, replace
 from typing import Any
 
 from digslam.observer.online import OnlineConfig
@@ -43,6 +43,10 @@ class ObserverConfig(_Config):
         start_box: Half-width (m) of the initial position box around the true start.
         horizon: Steps that normalise the elapsed time in ``"state"`` (the registered step limit).
         online: Settings of the online filter (an ``OnlineConfig`` or a mapping).
+        q: Outliers allowed among the range readings of one step: the filter's q-relaxed mode
+            (``OnlineConfig.q``, thesis §2.6.2), the way to make no false claim from up to ``q`` bad readings
+            per step. 0 keeps ``online.q``; a non-zero value sets it (and must agree with a non-zero
+            ``online.q``). After construction ``q == online.q``.
     """
 
     grid_cell: float = 0.15625
@@ -54,11 +58,26 @@ class ObserverConfig(_Config):
     start_box: float = 0.0
     horizon: int = 1000
     online: OnlineConfig = field(default_factory=OnlineConfig)
+    q: int = 0
 
     def __post_init__(self) -> None:
         if isinstance(self.online, Mapping):
             object.__setattr__(self, "online", OnlineConfig.from_dict(self.online))
         _check(isinstance(self.online, OnlineConfig), "online", "must be an OnlineConfig or a mapping")
+        q = self.q
+        _check(
+            isinstance(q, int) and not isinstance(q, bool) and q >= 0,
+            "q",
+            f"must be an integer >= 0 (outliers allowed per step), got {q!r}",
+        )
+        _check(
+            not (q and self.online.q and q != self.online.q),
+            "q",
+            f"{q} disagrees with online.q = {self.online.q}",
+        )
+        if q and not self.online.q:
+            object.__setattr__(self, "online", replace(self.online, q=q))
+        object.__setattr__(self, "q", self.online.q)
         c = self.grid_cell
         _check(
             isinstance(c, (int, float)) and math.isfinite(c) and c > 0,
@@ -141,6 +160,19 @@ class DigCoverageConfig(_Config):
         ``explore`` (whose unknown keys raise ``ValueError``)."""
         own = {f for f in cls.__dataclass_fields__}
         obs = set(ObserverConfig.__dataclass_fields__)
+        raw = set(ExploreConfig.__dataclass_fields__)
+        unknown = sorted(set(kwargs) - own - obs - raw)
+        if unknown:  # name every key the user can pass here, not only the raw env's
+            import difflib
+
+            known = sorted((own - {"observer", "explore"}) | obs | raw)
+            hints = [m for k in unknown for m in difflib.get_close_matches(k, known, n=1)]
+            hint = f" (did you mean {', '.join(map(repr, hints))}?)" if hints else ""
+            mine = sorted(own - {"observer", "explore"})
+            raise ValueError(
+                f"DigCoverage: unknown keyword(s) {unknown}{hint}; known: coverage {mine}, observer "
+                f"{sorted(obs)}, raw environment {sorted(raw)}"
+            )
         mine = {k: v for k, v in kwargs.items() if k in own}
         o = {k: v for k, v in kwargs.items() if k in obs}
         e = {k: v for k, v in kwargs.items() if k not in own and k not in obs}

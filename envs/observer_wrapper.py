@@ -14,9 +14,35 @@ pose box, the dig zone ``M⁻`` and the explored thick set, and the wrapper hand
 ``info`` adds the sets as arrays (``explored`` int8 CLEAR/PENUMBRA/DARK, ``dig`` and ``clear`` bool, all
 ``(ny, nx)`` with row 0 at the top; ``pose_box (2, 2)``, ``heading_box (2,)``), ``certified_coverage``
 (clear cells in the reachable free area over that area, :func:`reachable_free`), ``clear_area`` (m²),
-``true_coverage`` (the raw env's ground-truth share) and ``consistent`` / ``inconsistent_step``.
-If the filter finds the data inconsistent (e.g. an outlier) it stops, every claim is withdrawn (the map
-becomes all penumbra) and the episode is truncated: never a false claim.
+``true_coverage`` (the ground truth over the same cells: the share of the reachable free cells whose centre
+was truly sensed, so ``certified_coverage <= true_coverage`` at every step, checked by ``monitor=True``)
+and ``consistent`` / ``inconsistent_step``.
+If the filter finds the data inconsistent (an empty pose box) it stops, every claim is withdrawn (the map
+becomes all penumbra) and the episode is truncated.
+
+**What is promised, and when the data break their bounds.** The claims (the true position lies in the pose
+box and the heading in its interval; every dug or clear cell holds no obstacle point; every clear cell was
+sensed, no dark cell was) are proved under a premise on the records; the filter never reads the record's
+``outlier`` flag.
+
+* ``q = 0`` (default): premise, *every* interval of every record contains the truth. If one range reading
+  misses it, nothing is promised from that step on: the filter notices only when the data make the pose
+  box empty, which may be steps later or never, and until then the reading's claims stand. One false long
+  echo (or a range shifted up by 0.3 m) digs through a rock at once: obstacle cells claimed free and clear.
+  Detection then withdraws every claim (and truncates the episode), but what the agent was shown before
+  was false.
+* ``q >= 1`` (``ObserverConfig(q=q)``, the filter's q-relaxed mode, thesis §2.6.2): premise, the
+  odometry, compass and start box hold and *at most* ``q`` *of the range readings of each step* miss the
+  truth (any readings, unflagged, possibly different ones each step). Then no claim is false, at any step:
+  a cell is dug or clear only where ``q + 1`` readings of the step prove it free, the pose box is the hull of
+  the positions consistent with all but ``q`` echoes, and the possibly sensed zone grows with the maximum
+  ranges (:class:`~digslam.observer.online.OnlineDigSlam`). This is the documented way to get no false
+  claim from up to ``q`` bad readings per step; it costs coverage (fewer cells are proved) and some update
+  time. With more than ``q`` bad readings in a step the ``q = 0`` statement applies again: an empty box is
+  still reported, but claims made before may be false.
+
+``digslam/DigCoverageOutliers-v0`` pairs the two: outliers capped at ``q = 1`` per step
+(``noise.max_outliers``) and an observer with ``q = 1``.
 
 Records go to the filter as they come: record ``k``'s odometry bounds the step that ends at ``t_k``, the
 data contract of :mod:`digslam.observer.record` that both the env and the filter follow.
@@ -32,6 +58,7 @@ True
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from typing import Any
@@ -46,6 +73,7 @@ from digslam.observer.online import OnlineConfig, OnlineDigSlam
 from digslam.observer.record import MissionRecord
 from digslam.observer.thick_sep import PENUMBRA
 
+from .coverage import Coverage
 from .monitor import GuaranteeMonitor
 from .observer_config import ObserverConfig
 from .observer_maps import _observe, crop_window, fill_map, pixel_blocks
@@ -96,11 +124,13 @@ class GuaranteedObserver(gym.Wrapper):
 
     Args:
         env: an :class:`~digslam.envs.explore_env.ExploreEnv` (possibly wrapped).
-        grid_cell, map_size, crop, monitor: override the fields of ``config``.
+        grid_cell, map_size, crop, monitor, q: override the fields of ``config`` (``q`` also sets the
+            filter's ``OnlineConfig.q``).
         config: an :class:`ObserverConfig`, a mapping, or an ``OnlineConfig`` (filter settings only).
 
-    When ``env`` is the raw env itself (no wrapper between), its ``raw_observation`` is switched off: the
-    agent sees this wrapper's observation only, so the raw one is not built on each step.
+    When ``env`` is the raw env itself (no wrapper between), :meth:`step` calls its internal fast path
+    ``_step(action, observe=False)``: the agent sees this wrapper's observation only, so the raw one is not
+    built on each step. The raw env's own ``step`` keeps the Gymnasium contract.
     """
 
     def __init__(
@@ -111,6 +141,7 @@ class GuaranteedObserver(gym.Wrapper):
         crop: float | None = None,
         monitor: bool | None = None,
         config: ObserverConfig | OnlineConfig | Mapping[str, Any] | None = None,
+        q: int | None = None,
     ) -> None:
         super().__init__(env)
         if isinstance(config, OnlineConfig):
@@ -118,6 +149,10 @@ class GuaranteedObserver(gym.Wrapper):
         cfg = config if isinstance(config, ObserverConfig) else ObserverConfig.from_dict(config or {})
         over = {"grid_cell": grid_cell, "map_size": map_size, "crop": crop, "monitor": monitor}
         cfg = cfg.replace(**{k: v for k, v in over.items() if v is not None})
+        if q is not None:
+            if not (isinstance(q, int) and not isinstance(q, bool) and q >= 0):
+                raise ValueError(f"q: must be an integer >= 0 (outliers allowed per step), got {q!r}")
+            cfg = cfg.replace(q=q, online=dataclasses.replace(cfg.online, q=q))
         self.obs_config = cfg
         raw = env.unwrapped
         self.grid = make_grid(cfg, raw.generator.frame)
@@ -130,8 +165,8 @@ class GuaranteedObserver(gym.Wrapper):
             }
         )
         self.filter = OnlineDigSlam(self.grid, cfg.online)
-        if env is raw:  # nothing between reads the raw observation, which this wrapper replaces
-            raw.raw_observation = False
+        # nothing between reads the raw observation, which this wrapper replaces: skip building it
+        self._fast = env is raw
         self._extra_info: dict[str, Any] = {}  # constant keys added to every info (subclasses)
         g = self.grid
         self.cell_area = g.cell_size[0] * g.cell_size[1]
@@ -168,13 +203,21 @@ class GuaranteedObserver(gym.Wrapper):
         hi = np.minimum(p + b, np.array(self.grid.hi))
         self.filter.reset(lo, hi, info["record"])
         self.steps, self._cache_step = 0, -1
-        self.monitor = GuaranteeMonitor(raw.world, self.grid) if self.obs_config.monitor else None
+        # ground truth over the cells of the certified coverage, the reachable free area (:mod:`.coverage`)
+        self._suite = raw.suite
+        self.truth_coverage = Coverage.on_cells(self.reachable[::-1], self.grid.lo, self.grid.cell_size,
+                                                float(raw.suite.r_max.max()))  # fmt: skip
+        self.truth_coverage.update(truth.pose, raw.suite, truth.ranges)
+        self.monitor = (GuaranteeMonitor(raw.world, self.grid, coverage=(self.reachable, self.truth_coverage))
+                        if self.obs_config.monitor else None)  # fmt: skip
         self._check(info)
         self._clear_count = self._certified_count()
         return self.observation(), self._obs_info(info)
 
     def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
-        _, reward, terminated, truncated, info = self.env.step(action)
+        step = self.env._step(action, observe=False) if self._fast else self.env.step(action)
+        _, reward, terminated, truncated, info = step
+        self.truth_coverage.update(info["truth"].pose, self._suite, info["truth"].ranges)
         self.filter.update(info["record"])  # :meth:`_feed`, inlined
         self.steps += 1
         if self.monitor is not None:
@@ -263,12 +306,12 @@ class GuaranteedObserver(gym.Wrapper):
                     "pose_box": np.array((f.pose_lo, f.pose_hi), np.float64),
                     "heading_box": np.array((f.heading_lo, f.heading_hi), np.float64),
                     "certified_coverage": n / self.n_reachable, "clear_area": n * self.cell_area,
-                    "true_coverage": float(info.get("coverage", 0.0)), "consistent": True,
+                    "true_coverage": self.truth_coverage.fraction, "consistent": True,
                     "inconsistent_step": f.inconsistent_step, **self._extra_info}  # fmt: skip
         shape = self.grid.shape
         return {**info, "explored": np.full(shape, PENUMBRA), "dig": np.zeros(shape, dtype=bool),
                 "clear": np.zeros(shape, bool), "pose_box": np.full((2, 2), np.nan),
                 "heading_box": np.full(2, np.nan), "certified_coverage": 0 / self.n_reachable,
-                "clear_area": 0 * self.cell_area, "true_coverage": float(info.get("coverage", 0.0)),
+                "clear_area": 0 * self.cell_area, "true_coverage": self.truth_coverage.fraction,
                 "consistent": False, "inconsistent_step": f.inconsistent_step,
                 **self._extra_info}  # fmt: skip

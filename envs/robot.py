@@ -1,13 +1,15 @@
 """A disc robot with exact unicycle kinematics, blocked (never sliding) by the world's walls.
 
-Motion model (the data contract of the guaranteed observer, see :mod:`.missions`): the robot follows exact
-arcs of constant ``(v_i, ω)``, so ``ẋ = v (cos ψ, sin ψ)`` holds at every instant with ``ψ`` linear. ``v_i``
-is the commanded speed up to the first substep whose sweep is blocked; the rest of the step runs, as one arc,
-at that speed scaled by the largest fraction in ``(1/2, 1/4, 1/8, 0)`` whose sweep is clear. A sweep is
-checked at the midpoints of ``m`` equal pieces of the arc with a margin of half a piece's travel (every
-point of the arc lies within that of a midpoint), so the nominal disc never overlaps an obstacle and never
-tunnels. Rotation in place is always allowed (the disc does not move). A bump is a step that gets blocked
-after an unblocked one. Each step runs compiled (:mod:`.robot_jit`).
+Motion model (the data contract of the guaranteed observer, see :mod:`.missions`): the robot follows the exact
+arcs of :mod:`.arc` at constant speed ``v_i`` with ``ψ`` linear over each piece, so ``ẋ = v (cos ψ, sin ψ)``
+holds at every instant. The heading the simulator stores is the true heading; the position it stores is within
+:attr:`RobotSim.pose_error` (a proved, accumulated bound) of the true one. ``v_i`` is the commanded speed up
+to the first substep whose sweep is blocked; the rest of the step runs, as one arc, at that speed scaled by
+the largest fraction in ``(1/2, 1/4, 1/8, 0)`` whose sweep is clear. A sweep is checked at the midpoints of
+``m`` equal pieces of the arc with a margin of half a piece's travel (every point of the arc lies within that
+of a midpoint), so the nominal disc never overlaps an obstacle and never tunnels. Rotation in place is always
+allowed (the disc does not move). A bump is a step that gets blocked after an unblocked one. Each step runs
+compiled (:mod:`.robot_jit`).
 
 An earlier version drove the robot through pymunk joints: the body's velocity then lagged its heading (by up
 to 0.5 rad on reversals) and slid along walls, motions that no unicycle with the recorded heading explains,
@@ -23,6 +25,7 @@ import numpy as np
 import pymunk
 
 from . import geometry_jit as gjit
+from .arc import arc
 from .robot_jit import robot_step_kernel
 from .world import World
 
@@ -32,17 +35,6 @@ FRACTIONS = (1.0, 0.5, 0.25, 0.125)
 #: Sweep check points per substep.
 SWEEP_POINTS = 4
 _FRACTIONS = np.array(FRACTIONS[1:])
-
-
-def arc(pose: np.ndarray, v: float, w: float, tau: float) -> np.ndarray:
-    """Exact unicycle pose after ``tau`` s of constant ``(v, ω)`` from ``pose`` (plain floats; the compiled
-    step :func:`.robot_jit.robot_step_kernel` uses the same formulas)."""
-    x, y, th = (float(c) for c in pose)
-    th2 = th + w * tau
-    if abs(w) < 1e-12:
-        return np.array([x + v * tau * math.cos(th), y + v * tau * math.sin(th), th2])
-    k = v / w
-    return np.array([x + k * (math.sin(th2) - math.sin(th)), y - k * (math.cos(th2) - math.cos(th)), th2])
 
 
 class RobotSim:
@@ -98,6 +90,10 @@ class RobotSim:
         self._v, self._w, self._blocked = 0.0, 0.0, False
         self.speed_hull: tuple[float, float] = (0.0, 0.0)
         self.yaw_hull: tuple[float, float] = (0.0, 0.0)
+        #: The last step's pieces ``(v, tau, theta_end)`` (:mod:`.arc`); at reset, at rest.
+        self.pieces = np.array([[0.0, 0.0, self._pose[2]], [0.0, 0.0, self._pose[2]]])
+        #: Proved bound on ``max(|x - x_true|, |y - y_true|)`` of :attr:`pose` (the heading is exact).
+        self.pose_error = 0.0
 
     def _on_bump(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
         pass  # contacts of the reference pymunk loop (benchmarks) are not the robot's bumps
@@ -105,14 +101,20 @@ class RobotSim:
     def step(self, v: float, omega: float, dt: float, substeps: int) -> int:
         """Advance ``dt`` seconds under command ``(v, omega)``; return the bumps that occurred.
 
-        The substeps before the first blocked one run at full speed; the rest of the step runs at the
-        largest fraction of :data:`FRACTIONS` (or 0) whose sweep is clear, as one arc (compiled,
-        :func:`.robot_jit.robot_step_kernel`). Afterwards :attr:`speed_hull` and :attr:`yaw_hull` hold the
-        hull of the true speed and yaw rate over the whole step.
+        ``dt`` must be the exact time between the step's two records (:func:`.arc.exact_duration`). The
+        substeps before the first blocked one run at full speed; the rest of the step runs at the largest
+        fraction of :data:`FRACTIONS` (or 0) whose sweep is clear, as one arc (compiled,
+        :func:`.robot_jit.robot_step_kernel`). Afterwards :attr:`speed_hull` and :attr:`yaw_hull` bound the
+        true speed and yaw rate over the whole step (the yaw rate outward-rounded), :attr:`pieces` holds the
+        step's pieces ``(v, tau, theta_end)`` and :attr:`pose_error` the accumulated position-error bound.
         """
         v, omega = float(v), float(omega)
-        first, vi = robot_step_kernel(self._pose, v, omega, float(dt), int(substeps), SWEEP_POINTS,
-                                      self.radius, self.edges, self.bbox, _FRACTIONS)  # fmt: skip
+        first, vi, err, w_lo, w_hi = robot_step_kernel(
+            self._pose, v, omega, float(dt), int(substeps), SWEEP_POINTS, self.radius, self.edges,
+            self.bbox, _FRACTIONS, self.pieces,
+        )
+        if err > 0.0:  # rounded upward: the sum stays a bound
+            self.pose_error = math.nextafter(self.pose_error + err, math.inf)
         rest = substeps - first
         bumped = rest > 0 and not self._blocked
         if bumped:
@@ -122,8 +124,8 @@ class RobotSim:
             self.speed_hull = (min(v, vi), max(v, vi))
         else:
             self.speed_hull = (vi, vi) if rest else (v, v)
-        self._v, self._w = (vi if rest else v), omega
-        self.yaw_hull = (omega, omega)
+        self._v, self._w = (vi if rest else v), 0.5 * (w_lo + w_hi)
+        self.yaw_hull = (w_lo, w_hi)
         self.body.position = (float(self._pose[0]), float(self._pose[1]))
         self.body.angle = float(self._pose[2])
         return int(bumped)
@@ -140,5 +142,9 @@ class RobotSim:
 
     @property
     def yaw_rate(self) -> float:
-        """True yaw rate (rad/s)."""
+        """True yaw rate (rad/s), to within an ulp: the middle of :attr:`yaw_hull` (the exact rates are
+        ``(theta_end - theta_start) / tau`` of :attr:`pieces`)."""
         return self._w
+
+
+__all__ = ["FRACTIONS", "ROBOT_TYPE", "SWEEP_POINTS", "WALL_TYPE", "RobotSim", "arc"]

@@ -4,9 +4,11 @@ Range truth is geometric (the exact sector distance of :mod:`.geometry` over the
 bounding boxes), never a ray fan. The omnidirectional sensor is a cone of half-aperture ``pi``.
 
 Odometry may be given as a hull ``(lo, hi)`` of the true values over a time slice (the env passes the hull
-over every physics substep of the step that just ended); the reported interval then contains the whole hull.
-``tol`` widens every finite bound by ``tol * max(1, |bound|)`` to cover the simulator's own float64 rounding
-(:data:`SIM_TOL`, the same widening as :data:`digslam.envs.missions.SIM_TOL`). Ranges, noise and widening
+over the pieces of the step that just ended); the reported interval then contains the whole hull. Ranges
+may likewise be given as rigorous bounds ``(n, 2)`` of the true distances: :meth:`SensorSuite.range_bounds`
+computes them from the simulator's pose and its proved pose error (:mod:`.arc`), so the record contains
+the exact truth, floating point included, with no tolerance chosen by hand. ``tol`` is an optional extra
+widening (``tol * max(1, |bound|)``) for callers whose truths are plain floats. Ranges, noise and widening
 run compiled (:mod:`.geometry_jit`, :mod:`.noise_jit`).
 """
 
@@ -24,9 +26,6 @@ from .config import ExploreConfig, NoiseConfig
 from .noise import outliers
 from .noise_jit import MODEL_CODES, record_kernel
 from .world import World
-
-#: Relative (absolute below magnitude 1) widening of the env's records for the simulator's float rounding.
-SIM_TOL = 1e-12
 
 Hull = float | tuple[float, float]
 _ROWS = ("speed", "yaw_rate", "heading")
@@ -97,6 +96,17 @@ class SensorSuite:
                            self._k_r_max, world.edges, world.bbox, self._reach, d, self._wit)  # fmt: skip
         return d
 
+    def range_bounds(self, world: World, pose: np.ndarray, pose_error: float) -> np.ndarray:
+        """Rigorous bounds ``(n, 2)`` of the true distances from the true pose, whose heading is ``pose[2]``
+        exactly and whose position lies within ``pose_error`` of ``pose[:2]`` per coordinate
+        (:func:`.geometry_jit.sector_bounds_kernel`; ``inf`` upper bounds where no obstacle point is proved
+        inside a cone, lower bounds above ``r_max`` where nothing lies within it)."""
+        out = np.empty((self.n, 2))
+        gjit.sector_bounds_kernel(float(pose[0]), float(pose[1]), float(pose[2]), self._k_alpha,
+                                  self._k_gamma, world.edges, world.bbox, self._reach * (1.0 + 1e-9) + 1e-9,
+                                  float(pose_error), out)  # fmt: skip
+        return out
+
 
 def measure_step(
     t: float,
@@ -109,29 +119,36 @@ def measure_step(
     rng: np.random.Generator,
     tol: float = 0.0,
 ) -> MissionRecord:
-    """Noisy record of one step from the true values (``ranges`` from :meth:`SensorSuite.true_ranges`).
+    """Noisy record of one step from the true values.
 
-    ``speed`` and ``yaw_rate`` are true values or hulls ``(lo, hi)`` of true values; the interval reported
-    for a hull is the noisy interval of its midpoint widened by its half-width, so it contains the whole hull
-    (under ``adversarial`` noise the hull touches a bound). The random generator is advanced by the same
-    amount whatever the values, so runs stay reproducible.
+    ``ranges`` holds the true distances ``(n,)`` (:meth:`SensorSuite.true_ranges`, ``inf`` for no echo) or
+    rigorous bounds ``(n, 2)`` of them (:meth:`SensorSuite.range_bounds`). ``speed`` and ``yaw_rate`` are
+    true values or hulls ``(lo, hi)`` of true values; the interval reported for a hull is the noisy interval
+    of its midpoint widened by its half-width, so it contains the whole hull (under ``adversarial`` noise
+    the hull touches a bound). The random generator is advanced by the same amount whatever the values, so
+    runs stay reproducible.
     """
     (s_lo, s_hi), (w_lo, w_hi) = _hull(speed), _hull(yaw_rate)
     n = suite.n
-    r = np.ascontiguousarray(ranges, dtype=np.float64)
-    if r.shape != (n,):
-        raise ValueError(f"ranges: expected shape ({n},), got {r.shape}")
+    r = ranges
+    if not (type(r) is np.ndarray and r.dtype == np.float64 and r.shape == (n, 2) and r.flags.c_contiguous):
+        r = np.asarray(ranges, dtype=np.float64)
+        if r.shape == (n,):
+            r = np.repeat(r[:, None], 2, axis=1)  # a known truth: [r, r]
+        elif r.shape != (n, 2):
+            raise ValueError(f"ranges: expected shape ({n},) or ({n}, 2), got {r.shape}")
+        r = np.ascontiguousarray(r)
     u = rng.uniform(-1.0, 1.0, n + 3)
     if noise.outlier_prob > 0:
-        flag, o_lo, o_hi = outliers(n, noise.outlier_prob, suite.r_max, noise.range, rng)
+        flag, o_lo, o_hi = outliers(n, noise.outlier_prob, suite.r_max, noise.range, rng, noise.max_outliers)
     else:
         flag = np.zeros(n, dtype=bool)
         o_lo = o_hi = suite._k_r_max
     out, no_echo = np.empty((n + 3, 2)), np.empty(n, dtype=bool)
-    bad = record_kernel(r, suite._k_r_max, s_lo, s_hi, w_lo, w_hi, float(heading), float(noise.speed),
-                        float(noise.yaw_rate), float(noise.heading), float(noise.range), u,
-                        MODEL_CODES[noise.model], float(noise.bias), flag, o_lo, o_hi, float(tol), out,
-                        no_echo)  # fmt: skip
+    bad = record_kernel(r, suite._k_r_max, s_lo, s_hi, w_lo, w_hi, float(heading),
+                        float(noise.speed), float(noise.yaw_rate), float(noise.heading),
+                        float(noise.range), u, MODEL_CODES[noise.model], float(noise.bias), flag, o_lo,
+                        o_hi, float(tol), out, no_echo)  # fmt: skip
     if bad >= 0:
         name = _ROWS[bad] if bad < 3 else f"range[{bad - 3}]"
         raise ValueError(f"{name}: interval is not [lo <= hi]: {out[bad].tolist()}")

@@ -3,6 +3,12 @@
 Every kernel takes and returns pairs ``(lo, hi)`` of float64 arrays of broadcastable shapes. The empty
 interval is ``[+inf, -inf]``: it goes in, it comes out, and no NaN ever reaches a bound. Bounds are
 rounded outward by :mod:`.rounding`. These kernels are the fast path under :class:`IntervalArray`.
+
+Infinite operands (IEEE 1788-2015 §7.2, §10.5.1): ``±∞`` is no real number, so a pair with an infinite
+*point* — ``[+∞, +∞]``, ``[-∞, -∞]``, or any pair with ``lo = +∞`` or ``hi = -∞`` — holds no real
+and is read as the empty interval by every kernel (:func:`empty_mask`). A raw float ``±∞`` meeting an
+interval therefore gives the empty interval: ``[0, 1] + ∞ = ∅``, ``[1, 2]·∞ = ∅``, ``[1, 2]/∞ = ∅``,
+``[2¹⁰²⁴⁻, +∞) + (-∞) = ∅``; unbounded intervals such as ``[0, +∞)`` are of course fine.
 """
 
 from __future__ import annotations
@@ -16,8 +22,9 @@ _INF = np.inf
 
 
 def empty_mask(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """True where ``[lo, hi]`` is empty."""
-    return lo > hi
+    """True where ``[lo, hi]`` holds no real number: ``lo > hi``, or an infinite point (``lo = +∞`` or
+    ``hi = -∞``, IEEE 1788: ``±∞`` is not a real)."""
+    return (lo > hi) | (lo == _INF) | (hi == -_INF)
 
 
 def set_empty(lo: np.ndarray, hi: np.ndarray, mask: np.ndarray) -> Pair:

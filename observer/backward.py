@@ -2,7 +2,9 @@
 
 For a node ``z = op(x, y)`` each rule returns the contracted arguments: the smallest intervals this
 rule can prove to hold every ``x ∈ [x]``, ``y ∈ [y]`` with ``op(x, y) ∈ [z]``. All rules are sound
-(outward rounded through :mod:`.arith`); some are not minimal (``atan2`` uses ``y = x·tan z``).
+(outward rounded through :mod:`.arith`); ``atan`` and ``atan2`` (through the minimal polar contractor
+of §3.2.3) are minimal up to rounding on bounded boxes, ``sin``, ``cos``, ``tan`` up to their period
+enclosure.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import numpy as np
 from . import arith as A
 from . import rounding as rnd
 from . import trig as T
+from .polar_jit import ctc_polar_batch
 
 Pair = tuple[np.ndarray, np.ndarray]
 _INF = np.inf
@@ -163,11 +166,20 @@ def b_tan(z: Pair, x: Pair, p: object) -> tuple[Pair, ...]:
 
 
 def b_atan(z: Pair, x: Pair, p: object) -> tuple[Pair, ...]:
-    zl, zh = inter(z, (np.full_like(z[0], -rnd.HALF_PI_UP), np.full_like(z[1], rnd.HALF_PI_UP)))
-    t = T.tan((zl, zh))
-    lo = np.where(zl > -rnd.HALF_PI_DOWN, t[0], -_INF)
-    hi = np.where(zh < rnd.HALF_PI_DOWN, t[1], _INF)
-    return (A.set_empty(*inter(x, (lo, hi)), zl > zh),)
+    """``z = atan x``: ``x ∈ tan([z] ∩ (-π/2, π/2))``, taken end by end because ``tan`` is increasing
+    there: ``[tan z⁻, tan z⁺]``, with ``-∞`` (``+∞``) when ``z⁻ <= -π/2`` (``z⁺ >= π/2``). Minimal up
+    to outward rounding; ``tan`` of the whole clipped interval would be ``ℝ`` whenever it touched a pole.
+    """
+    zl, zh = z
+    lo_ok = zl >= -rnd.HALF_PI_DOWN  # the float -π/2 rounded toward 0 is above -π/2: tan is finite there
+    hi_ok = zh <= rnd.HALF_PI_DOWN
+    with np.errstate(invalid="ignore"):
+        t_lo = T.tan((np.where(lo_ok, zl, 0.0), np.where(lo_ok, zl, 0.0)))[0]
+        t_hi = T.tan((np.where(hi_ok, zh, 0.0), np.where(hi_ok, zh, 0.0)))[1]
+    lo = np.where(lo_ok, t_lo, -_INF)
+    hi = np.where(hi_ok, t_hi, _INF)
+    dead = A.empty_mask(zl, zh) | (zl > rnd.HALF_PI_DOWN) | (zh < -rnd.HALF_PI_DOWN)
+    return (A.set_empty(*inter(x, (lo, hi)), dead),)
 
 
 def b_asin(z: Pair, x: Pair, p: object) -> tuple[Pair, ...]:
@@ -180,27 +192,58 @@ def b_acos(z: Pair, x: Pair, p: object) -> tuple[Pair, ...]:
     return (inter(x, T.cos(zc)),)
 
 
+def _tan_branch(z: Pair) -> Pair:
+    """``tan([z])`` when ``[z]`` holds no pole (monotone there: tight), else ``ℝ`` (:func:`.trig.tan`)."""
+    return T.tan(z)
+
+
 def b_atan2(z: Pair, y: Pair, x: Pair, p: object) -> tuple[Pair, ...]:
-    """``z = atan2(y, x)``: sign constraints from the angle range, then ``y = x·tan z`` where
-    ``cos z ≠ 0`` and ``x = y·cot z`` where ``sin z ≠ 0`` (each with its reverse)."""
+    """``z = atan2(y, x)``: minimal up to outward rounding on bounded boxes.
+
+    ``atan2(y, x) = z`` means ``(x, y) = (ρ cos z, ρ sin z)`` for some ``ρ > 0`` with ``z ∈ (-π, π]``,
+    i.e. the polar constraint of §3.2.3 (Eq. 3.22) with ``[ρ] = [0, |(x, y)|⁺]`` and
+    ``[θ] = [z] ∩ [-π, π]``: the minimal polar contractor (:func:`.polar_jit.ctc_polar_batch`, Eq.
+    3.34) returns the hull ``⟦Π ∩ [p]⟧`` and hence the smallest ``[x]×[y]`` (the origin, which has no
+    angle, can only add itself). For unbounded boxes (where that contractor only clips) the rule is
+    also intersected with the sign constraints of the angle range, ``y = x·tan z`` where ``cos z ≠ 0``
+    and ``x = y·tan(π/2 - z)`` where ``sin z ≠ 0`` (each with its reverse).
+    """
     zl, zh = z
+    shape = np.broadcast_shapes(np.shape(zl), np.shape(y[0]), np.shape(x[0]))
+    zl, zh, yl0, yh0, xl0, xh0 = (np.broadcast_to(v, shape) for v in (zl, zh, *y, *x))
+    # polar geometry (Eq. 3.34): columns (x, y, ρ, θ)
+    with np.errstate(invalid="ignore", over="ignore"):
+        mx = np.maximum(np.abs(xl0), np.abs(xh0))
+        my = np.maximum(np.abs(yl0), np.abs(yh0))
+        rho = rnd.sqrt_up(rnd.add_up(rnd.mul_up(mx, mx), rnd.mul_up(my, my)))
+    rho = np.where(np.isnan(rho), _INF, rho)
+    tl, th = np.maximum(zl, -rnd.PI_UP), np.minimum(zh, rnd.PI_UP)
+    plo = np.stack([xl0, yl0, np.zeros(shape), tl], axis=-1).reshape(-1, 4)
+    phi = np.stack([xh0, yh0, rho, th], axis=-1).reshape(-1, 4)
+    dead = A.empty_mask(zl, zh) | (tl > th) | A.empty_mask(yl0, yh0) | A.empty_mask(xl0, xh0)
+    plo[dead.reshape(-1)], phi[dead.reshape(-1)] = _INF, -_INF
+    clo, chi = ctc_polar_batch(np.ascontiguousarray(plo), np.ascontiguousarray(phi), False)
+    x = (clo[:, 0].reshape(shape), chi[:, 0].reshape(shape))
+    y = (clo[:, 1].reshape(shape), chi[:, 1].reshape(shape))
+    # sign constraints and the tangent rules (needed where the box is unbounded)
     up, down = (zl >= 0), (zh <= 0)
     right = (zl >= -rnd.HALF_PI_DOWN) & (zh <= rnd.HALF_PI_DOWN)
     left = (zl >= rnd.HALF_PI_UP) | (zh <= -rnd.HALF_PI_UP)
     y = (np.where(up, np.maximum(y[0], 0.0), y[0]), np.where(down, np.minimum(y[1], 0.0), y[1]))
     x = (np.where(right, np.maximum(x[0], 0.0), x[0]), np.where(left, np.minimum(x[1], 0.0), x[1]))
-    y, x = A.set_empty(*y, y[0] > y[1]), A.set_empty(*x, x[0] > x[1])
-    c, s = T.cos(z), T.sin(z)
-    tan_ok = ~((c[0] <= 0) & (c[1] >= 0))
-    cot_ok = ~((s[0] <= 0) & (s[1] >= 0))
-    t = A.div(s, c)
+    y, x = A.set_empty(*y, A.empty_mask(*y)), A.set_empty(*x, A.empty_mask(*x))
+    t = _tan_branch((zl, zh))
+    tan_ok = (t[0] > -_INF) & (t[1] < _INF)
     y1 = inter(y, A.mul(x, t))
     x1 = mul_rev(y1, t, x)
     y, x = _pick(tan_ok, y1, y), _pick(tan_ok, x1, x)
-    ct = A.div(c, s)
+    half_pi = (np.full(shape, rnd.HALF_PI_DOWN), np.full(shape, rnd.HALF_PI_UP))
+    ct = _tan_branch(A.sub(half_pi, (zl, zh)))  # cot z = tan(π/2 - z)
+    cot_ok = (ct[0] > -_INF) & (ct[1] < _INF)
     x2 = inter(x, A.mul(y, ct))
     y2 = mul_rev(x2, ct, y)
-    return _pick(cot_ok, y2, y), _pick(cot_ok, x2, x)
+    y, x = _pick(cot_ok, y2, y), _pick(cot_ok, x2, x)
+    return A.set_empty(*y, dead), A.set_empty(*x, dead)
 
 
 def _pick(mask: np.ndarray, a: Pair, b: Pair) -> Pair:

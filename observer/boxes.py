@@ -25,7 +25,9 @@ Batch = tuple[np.ndarray, np.ndarray]
 def validate_batch(lo: Any, hi: Any, name: str = "boxes", n: int | None = None) -> Batch:
     """Check and convert a batch: float64 arrays of one shape ``(N, n)``, no NaN, ``lo <= hi``.
 
-    A single box of shape ``(n,)`` is promoted to ``(1, n)``. Empty rows (``[+inf, -inf]``) pass.
+    A single box of shape ``(n,)`` is promoted to ``(1, n)``. Empty rows (``[+inf, -inf]``) pass. An
+    interval ``[+inf, +inf]`` or ``[-inf, -inf]`` holds no real number (IEEE 1788) and is returned as
+    the empty interval ``[+inf, -inf]`` (a copy is made then; the inputs are never modified).
 
     Raises:
         ValueError: naming ``name`` and saying what is wrong.
@@ -40,10 +42,14 @@ def validate_batch(lo: Any, hi: Any, name: str = "boxes", n: int | None = None) 
         raise ValueError(f"{name}: boxes have dimension {lo.shape[1]}, expected {n}")
     if np.isnan(lo).any() or np.isnan(hi).any():
         raise ValueError(f"{name}: NaN bound in row {int(np.argwhere(np.isnan(lo) | np.isnan(hi))[0, 0])}")
-    bad = (lo > hi) & ~((lo == np.inf) & (hi == -np.inf))
+    top, bottom = lo == np.inf, hi == -np.inf
+    bad = (lo > hi) & ~(top & bottom)
     if bad.any():
         r, c = np.argwhere(bad)[0]
         raise ValueError(f"{name}: lower bound {lo[r, c]} above upper bound {hi[r, c]} (row {r}, column {c})")
+    point_inf = top ^ bottom  # [+inf, +inf] or [-inf, -inf]: no real number (IEEE 1788), read as empty
+    if point_inf.any():
+        lo, hi = np.where(point_inf, np.inf, lo), np.where(point_inf, -np.inf, hi)
     return lo, hi
 
 

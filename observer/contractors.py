@@ -150,9 +150,15 @@ class CtcFwdBwd(Ctc):
     compiled (:mod:`.jit_hc4`) when ``f`` has a :class:`~.jit_tape.Tape`, else with numpy
     (:func:`hc4_backward`, which also serves the functions with trigonometric, ``min``/``max`` or
     ``atan2`` nodes).
+
+    With ``centred=True`` each output's natural enclosure is first intersected with the centred
+    (mean-value) form of :mod:`.centred` (Eq. 2.20, interval automatic differentiation on the DAG):
+    tighter on small boxes when variables occur several times, at about twice the forward cost; off by
+    default (the natural form is exact for functions where each variable occurs once, e.g. Ex. 2.7).
     """
 
-    def __init__(self, f: Function | Any, y: Any) -> None:
+    def __init__(self, f: Function | Any, y: Any, centred: bool = False) -> None:
+        self.centred = bool(centred)
         self.f = f if isinstance(f, Function) else Function(f)
         self.n = self.f.n
         if isinstance(y, tuple) and len(y) == 2 and not isinstance(y, IntervalArray):
@@ -167,8 +173,23 @@ class CtcFwdBwd(Ctc):
     def contract(self, lo: np.ndarray, hi: np.ndarray) -> Batch:
         tape = Tape.of(self.f)
         if tape is not None:
-            return hc4(tape, lo, hi, *self.y)
-        return chunked(lambda a, b: hc4_backward(self.f, self.f.forward(a, b), self.y, a, b), lo, hi)
+            return hc4(tape, lo, hi, *self.y, centred=self.centred)
+        f, y, centred = self.f, self.y, self.centred
+        return chunked(lambda a, b: hc4_backward(f, forward(f, a, b, centred), y, a, b), lo, hi)
+
+
+def forward(f: Function, lo: np.ndarray, hi: np.ndarray, centred: bool = False) -> list[Batch]:
+    """``f.forward(lo, hi)``, with each output node met with the centred form when ``centred``."""
+    vals = f.forward(lo, hi)
+    if centred:
+        from .centred import centred_image_numpy
+
+        clo, chi = centred_image_numpy(f, lo, hi)
+        for j, o in enumerate(f.outputs):
+            n_rows = (lo.shape[0],)
+            vals[o] = intersect((np.broadcast_to(vals[o][0], n_rows), np.broadcast_to(vals[o][1], n_rows)),
+                                (clo[:, j], chi[:, j]))  # fmt: skip
+    return vals
 
 
 def hc4_backward(f: Function, vals: list[tuple[np.ndarray, np.ndarray]], y: Batch, lo: np.ndarray,

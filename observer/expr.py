@@ -95,16 +95,21 @@ _interval.DEFER_TO = (Expr,)
 
 
 def lift(v: Any) -> Expr:
-    """An :class:`Expr` for ``v``: expressions pass, numbers and scalar intervals become constants."""
+    """An :class:`Expr` for ``v``: expressions pass, numbers and scalar intervals become constants.
+
+    A float ``±inf`` is no real number and becomes the empty constant ``[+inf, -inf]`` (the rule of
+    :func:`.interval.as_pair`): ``Function(lambda x: x[0] + inf)`` is empty everywhere."""
     if isinstance(v, Expr):
         return v
     if isinstance(v, IntervalArray):
         if v.ndim != 0:
             raise ValueError(f"constant: only scalar intervals can enter an expression, got shape {v.shape}")
         return Expr("const", (), (float(v.lo), float(v.hi)))
-    if isinstance(v, (int, float, np.integer, np.floating)) and np.isfinite(v):
+    if isinstance(v, (int, float, np.integer, np.floating)) and not np.isnan(v):
+        if np.isinf(v):  # no real number (IEEE 1788): the empty constant, as in interval arithmetic
+            return Expr("const", (), (np.inf, -np.inf))
         return Expr("const", (), (float(v), float(v)))
-    raise ValueError(f"constant: cannot use {v!r} in an expression (finite numbers and Interval only)")
+    raise ValueError(f"constant: cannot use {v!r} in an expression (numbers and scalar Interval only)")
 
 
 def _un(k: Callable[[Pair], Pair]) -> Callable[..., Pair]:
@@ -264,6 +269,37 @@ class Function:
         lo, hi = boxes.pair if isinstance(boxes, IntervalArray) else boxes
         lo, hi = validate_batch(lo, hi, "boxes", self.n)
         rlo, rhi = chunked(self._eval_batch, lo, hi)
+        if self.scalar_output:
+            rlo, rhi = rlo[:, 0], rhi[:, 0]
+        return IntervalArray._raw(rlo[0], rhi[0]) if single else IntervalArray._raw(rlo, rhi)
+
+    def jacobian(self, boxes: IntervalArray | Sequence[np.ndarray]) -> IntervalArray:
+        """Interval Jacobian ``[J_f]([x])`` (Eq. 2.20's ``[f']``) by automatic differentiation on the DAG
+        (:func:`.centred.jacobian`; compiled when ``f`` has a tape): ``(m, n)`` for a box, ``(N, m, n)``
+        for a batch, ``(n,)``/``(N, n)`` for a scalar function."""
+        from .centred import jacobian
+
+        single = isinstance(boxes, IntervalArray) and boxes.ndim == 1
+        lo, hi = boxes.pair if isinstance(boxes, IntervalArray) else boxes
+        lo, hi = validate_batch(lo, hi, "boxes", self.n)
+        jlo, jhi, _ = jacobian(self, lo, hi)
+        if self.scalar_output:
+            jlo, jhi = jlo[:, 0], jhi[:, 0]
+        return IntervalArray._raw(jlo[0], jhi[0]) if single else IntervalArray._raw(jlo, jhi)
+
+    def eval_centred(self, boxes: IntervalArray | Sequence[np.ndarray]) -> IntervalArray:
+        """Centred (mean-value) inclusion ``[f]({m}) + [J_f]([x])·([x] - m)`` met with the natural one
+        (Eq. 2.20–2.21; :func:`.centred.centred_image`), shaped as :meth:`eval`."""
+        from .centred import centred_image
+
+        single = isinstance(boxes, IntervalArray) and boxes.ndim == 1
+        lo, hi = boxes.pair if isinstance(boxes, IntervalArray) else boxes
+        lo, hi = validate_batch(lo, hi, "boxes", self.n)
+        nlo, nhi = chunked(self._eval_batch, lo, hi)
+        clo, chi = centred_image(self, lo, hi)
+        rlo, rhi = np.maximum(nlo, clo), np.minimum(nhi, chi)
+        empty = (rlo > rhi).any(axis=1, keepdims=True)
+        rlo, rhi = np.where(empty, np.inf, rlo), np.where(empty, -np.inf, rhi)
         if self.scalar_output:
             rlo, rhi = rlo[:, 0], rhi[:, 0]
         return IntervalArray._raw(rlo[0], rhi[0]) if single else IntervalArray._raw(rlo, rhi)

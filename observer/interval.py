@@ -3,6 +3,7 @@
 An :class:`IntervalArray` holds two float64 arrays ``lo`` and ``hi`` of one shape. Shape ``()`` is a
 single interval, ``(n,)`` a box, ``(N, n)`` a batch of ``N`` boxes. Arithmetic broadcasts like numpy
 and rounds outward. :func:`Interval` and :func:`Box` are conveniences for scalars and single boxes.
+A float ``±inf`` operand is no real number and reads as the empty interval (:func:`as_pair`).
 
 >>> Interval(-1, 5) & Interval(-3, 2)          # Ex. 2.1
 Interval(-1.0, 2.0)
@@ -47,12 +48,23 @@ def _check_bounds(lo: np.ndarray, hi: np.ndarray, name: str) -> None:
 
 
 def as_pair(x: Any, name: str = "x") -> Pair:
-    """Bounds of ``x`` (an :class:`IntervalArray`, a number or a float array taken as points)."""
+    """Bounds of ``x`` (an :class:`IntervalArray`, a number or a float array taken as points).
+
+    A point ``±inf`` is no real number (IEEE 1788-2015 §7.2): it becomes the empty interval, so every
+    operation of a float ``±inf`` with an interval is empty (``Interval(0, 1) + inf``,
+    ``Interval(1, 2) * inf``, ``Interval(1, 2) / inf``: all ``Interval.empty()``).
+
+    Raises:
+        ValueError: on a NaN point.
+    """
     if isinstance(x, IntervalArray):
         return x.lo, x.hi
     a = np.asarray(x, dtype=np.float64)
     if np.isnan(a).any():
         raise ValueError(f"{name}: NaN is not a point")
+    inf = np.isinf(a)
+    if inf.any():
+        return np.where(inf, np.inf, a), np.where(inf, -np.inf, a)
     return a, a
 
 
@@ -152,7 +164,10 @@ class IntervalArray:
         return midpoint(self.lo, self.hi)
 
     def contains(self, x: Any) -> Any:
-        """Whether the points (or intervals) ``x`` lie inside."""
+        """Whether the points (or intervals) ``x`` lie inside; ``±inf`` is never a member."""
+        if not isinstance(x, IntervalArray):
+            a = as_pair(x)[0]
+            return (self.lo <= a) & (a <= self.hi) & np.isfinite(a)
         lo, hi = as_pair(x)
         return (self.lo <= lo) & (hi <= self.hi) | (lo > hi)
 

@@ -12,8 +12,9 @@ boxes in machine code instead; this module gives them the same guarantee as :mod
 * Transcendental functions come from libm and are widened by :data:`~.rounding.LIBM_ULPS` ulps
   (:func:`wdn`, :func:`wup`).
 
-The empty interval is ``[+inf, -inf]``, as in :mod:`.arith`. Every kernel here is checked against exact
-rational arithmetic in ``tests/test_jit.py``.
+The empty interval is ``[+inf, -inf]``, as in :mod:`.arith`; an operand with an infinite point
+(``[+inf, +inf]``, ``[-inf, -inf]``) holds no real and gives the empty interval too (:func:`nil`).
+Every kernel here is checked against exact rational arithmetic in ``tests/test_jit.py``.
 
 Example:
     >>> lo, hi = imul(-1.0, 2.0, 0.1, 0.3)
@@ -32,7 +33,7 @@ import numpy as np
 from .rounding import LIBM_ULPS
 
 __all__ = ["LIBM_ULPS", "njit", "dn", "up", "wdn", "wup", "add_dn", "add_up", "sub_dn", "sub_up",
-           "mul_dn", "mul_up", "div_dn", "div_up", "sqrt_dn", "sqrt_up", "imul", "isqr",
+           "mul_dn", "mul_up", "div_dn", "div_up", "sqrt_dn", "sqrt_up", "nil", "imul", "isqr",
            "idiv", "isqrt"]  # fmt: skip
 
 _INF = math.inf
@@ -159,9 +160,16 @@ def sqrt_up(a: float) -> float:
 
 
 @njit(inline="always")
+def nil(al: float, ah: float) -> bool:
+    """Whether ``[al, ah]`` holds no real: empty (``al > ah``) or an infinite point (``al = +∞`` or
+    ``ah = -∞``; IEEE 1788: ``±∞`` is no real number, so an operation with it is empty)."""
+    return al > ah or al == _INF or ah == -_INF
+
+
+@njit(inline="always")
 def imul(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     """``[a] * [b]`` (Eq. 2.6); empty in, empty out."""
-    if al > ah or bl > bh:
+    if nil(al, ah) or nil(bl, bh):
         return _INF, -_INF
     lo = min(min(mul_dn(al, bl), mul_dn(al, bh)), min(mul_dn(ah, bl), mul_dn(ah, bh)))
     hi = max(max(mul_up(al, bl), mul_up(al, bh)), max(mul_up(ah, bl), mul_up(ah, bh)))
@@ -171,7 +179,7 @@ def imul(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
 @njit(inline="always")
 def isqr(al: float, ah: float) -> tuple[float, float]:
     """``[a]²``, tighter than ``[a] * [a]`` when ``0 ∈ [a]``."""
-    if al > ah:
+    if nil(al, ah):
         return _INF, -_INF
     if al >= 0.0:
         return mul_dn(al, al), mul_up(ah, ah)
@@ -184,7 +192,7 @@ def isqr(al: float, ah: float) -> tuple[float, float]:
 @njit(inline="always")
 def idiv(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     """``[a] / [b]`` (Eq. 2.7); the whole line when ``0 ∈ [b]`` (a hull, never wrong)."""
-    if al > ah or bl > bh:
+    if nil(al, ah) or nil(bl, bh):
         return _INF, -_INF
     if bl <= 0.0 <= bh:
         if bl == 0.0 and bh == 0.0:
@@ -198,6 +206,6 @@ def idiv(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
 @njit(inline="always")
 def isqrt(al: float, ah: float) -> tuple[float, float]:
     """``sqrt([a] ∩ [0, ∞))``; empty when ``[a] < 0``."""
-    if al > ah or ah < 0.0:
+    if nil(al, ah) or ah < 0.0:
         return _INF, -_INF
     return sqrt_dn(max(al, 0.0)), sqrt_up(ah)

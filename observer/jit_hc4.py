@@ -6,7 +6,9 @@ inclusion, Eq. 2.21), the outputs are intersected with ``[y]`` and the backward 
 projection rules of :mod:`.backward` (their scalar forms are here) down to the variables. A box is
 empty as soon as any node is. :func:`sep_box` gives both parts of the separator of Theorem 2.1
 (Eq. 2.51) for a box ``[y]``: ``x_out`` from ``[y]``, ``x_in`` as the hull of the projections of
-the ``2m`` closed half-spaces making up the complement of ``[y]``.
+the ``2m`` half-spaces making up the (open) complement of ``[y]``, each projected as its closure and
+skipped on the boxes whose image ``[f_j]([x])`` lies on ``[y]``'s side of it (then no point of the box
+is strictly beyond that bound, though the closure may touch it: a point with ``f = y⁻`` is inside).
 
 >>> t = Tape.of(Function(lambda x: x[0] ** 2 + x[1] ** 2))
 >>> lo, hi = np.array([[0.0, 0.0]]), np.array([[2.0, 2.0]])
@@ -23,36 +25,11 @@ import numpy as np
 
 from . import jit_tape as jt
 from .jit import njit
+from .jit_centred import centre_outputs, centres
 from .jit_tape import ABS, ADD, CONST, DIV, EXP, LOG, MUL, NEG, SQR, SQRT, SUB, VAR, Tape
 
 _INF = math.inf
 _KW = {"error_model": "numpy"}
-
-
-@njit(inline="always", **_KW)
-def _fwd_op(op: int, al: float, ah: float, bl: float, bh: float, p: int) -> tuple[float, float]:
-    """Natural inclusion of one node from its arguments' enclosures."""
-    if op == ADD:
-        return jt.iadd(al, ah, bl, bh)
-    if op == SUB:
-        return jt.isub(al, ah, bl, bh)
-    if op == MUL:
-        return jt.imul(al, ah, bl, bh)
-    if op == DIV:
-        return jt.ixdiv(al, ah, bl, bh)
-    if op == NEG:
-        return -ah, -al
-    if op == SQR:
-        return jt.isqr(al, ah)
-    if op == SQRT:
-        return jt.isqrt(al, ah)
-    if op == EXP:
-        return jt.iexp(al, ah)
-    if op == LOG:
-        return jt.ilog(al, ah)
-    if op == ABS:
-        return jt.iabs(al, ah)
-    return jt.ipown(al, ah, p)
 
 
 @njit(**_KW)
@@ -69,7 +46,7 @@ def _forward(code: np.ndarray, cst: np.ndarray, lo: np.ndarray, hi: np.ndarray, 
         else:
             bb = max(b, 0)
             for r in range(nb):
-                v[0, k, r], v[1, k, r] = _fwd_op(op, v[0, a, r], v[1, a, r], v[0, bb, r], v[1, bb, r], p)
+                v[0, k, r], v[1, k, r] = jt.fwd_op(op, v[0, a, r], v[1, a, r], v[0, bb, r], v[1, bb, r], p)
     for r in range(nb):
         for i in range(lo.shape[1]):
             if lo[r, i] > hi[r, i]:
@@ -234,13 +211,16 @@ def _store(code: np.ndarray, lo: np.ndarray, hi: np.ndarray, w: np.ndarray, aliv
 
 @njit(**_KW)
 def _sep_box_kernel(code: np.ndarray, cst: np.ndarray, outs: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                    y: np.ndarray) -> np.ndarray:  # fmt: skip
-    """``(4, N, n)``: ``in_lo, in_hi, out_lo, out_hi`` of the separator of ``f⁻¹([y])``, ``y (2, 1, m)``."""
+                    y: np.ndarray, centred: bool, mid: np.ndarray) -> np.ndarray:  # fmt: skip
+    """``(4, N, n)``: ``in_lo, in_hi, out_lo, out_hi`` of the separator of ``f⁻¹([y])``, ``y (2, 1, m)``;
+    with ``centred`` the outputs' natural enclosures are met with the mean-value form (centres ``mid``)."""
     v = np.empty((2, code.shape[0], lo.shape[0]))
     w, alive = np.empty_like(v), np.empty(lo.shape[0], dtype=np.bool_)
     res = np.empty((4, lo.shape[0], lo.shape[1]))
     res[0::2], res[1::2] = _INF, -_INF
     _forward(code, cst, lo, hi, v)
+    if centred:
+        centre_outputs(code, cst, outs, lo, hi, mid, v)
     _contract(code, outs, v, w, alive, y, -1, False)
     _store(code, lo, hi, w, alive, res, 2, False)
     half = np.empty_like(y)
@@ -248,19 +228,34 @@ def _sep_box_kernel(code: np.ndarray, cst: np.ndarray, outs: np.ndarray, lo: np.
         for side in range(2):
             half[0, 0, j], half[1, 0, j] = (-_INF, y[0, 0, j]) if side == 0 else (y[1, 0, j], _INF)
             _contract(code, outs, v, w, alive, half, j, False)
+            o = outs[j]
+            for r in range(lo.shape[0]):  # the complement is open: no f_j < ylo_j when [f_j]⁻ >= ylo_j
+                if (v[0, o, r] >= y[0, 0, j]) if side == 0 else (v[1, o, r] <= y[1, 0, j]):
+                    alive[r] = False
             _store(code, lo, hi, w, alive, res, 0, True)
+    for r in range(lo.shape[0]):  # f defined nowhere on a (non-empty) box: all of it is outside f⁻¹([y])
+        for j in range(outs.shape[0]):
+            if v[0, outs[j], r] > v[1, outs[j], r] and res[2, r, 0] > res[3, r, 0]:
+                nonempty = True
+                for i in range(lo.shape[1]):
+                    nonempty = nonempty and lo[r, i] <= hi[r, i]
+                if nonempty:
+                    res[0, r], res[1, r] = lo[r], hi[r]
     return res
 
 
 @njit(**_KW)
 def _hc4_kernel(code: np.ndarray, cst: np.ndarray, outs: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                y: np.ndarray) -> np.ndarray:  # fmt: skip
-    """``(2, N, n)``: HC4-revise of ``f(x_r) ∈ [y_r]`` for every row, ``y (2, N, m)``."""
+                y: np.ndarray, centred: bool, mid: np.ndarray) -> np.ndarray:  # fmt: skip
+    """``(2, N, n)``: HC4-revise of ``f(x_r) ∈ [y_r]`` for every row, ``y (2, N, m)`` (outputs met with
+    the mean-value form first when ``centred``)."""
     v = np.empty((2, code.shape[0], lo.shape[0]))
     w, alive = np.empty_like(v), np.empty(lo.shape[0], dtype=np.bool_)
     res = np.empty((2, lo.shape[0], lo.shape[1]))
     res[0], res[1] = _INF, -_INF
     _forward(code, cst, lo, hi, v)
+    if centred:
+        centre_outputs(code, cst, outs, lo, hi, mid, v)
     _contract(code, outs, v, w, alive, y, -1, True)
     _store(code, lo, hi, w, alive, res, 0, False)
     return res
@@ -299,29 +294,37 @@ def image(t: Tape, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return res[0], res[1]
 
 
-def hc4(t: Tape, lo: np.ndarray, hi: np.ndarray, ylo: np.ndarray,
-        yhi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """HC4-revise of ``f(x) ∈ [y]`` on a batch; ``[y]`` is ``(m,)`` or ``(N, m)`` per box."""
+def _mid(lo: np.ndarray, hi: np.ndarray, centred: bool) -> np.ndarray:
+    return centres(lo, hi) if centred else np.zeros((1, lo.shape[1]))
+
+
+def hc4(t: Tape, lo: np.ndarray, hi: np.ndarray, ylo: np.ndarray, yhi: np.ndarray,
+        centred: bool = False) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """HC4-revise of ``f(x) ∈ [y]`` on a batch; ``[y]`` is ``(m,)`` or ``(N, m)`` per box. With
+    ``centred``, each output's natural enclosure is first met with the mean-value form
+    (:mod:`.jit_centred`)."""
     shape = (lo.shape[0], t.outputs.shape[0])
     y = np.stack([np.broadcast_to(ylo, shape), np.broadcast_to(yhi, shape)]).astype(np.float64)
     lo, hi = _c(lo), _c(hi)
     if lo.shape[0] <= BLOCK:
-        res = _hc4_kernel(t.code, t.cst, t.outputs, lo, hi, y)
+        res = _hc4_kernel(t.code, t.cst, t.outputs, lo, hi, y, centred, _mid(lo, hi, centred))
         return res[0], res[1]
     res = np.empty((2, *lo.shape))
     for i in range(0, lo.shape[0], BLOCK):
         b = slice(i, i + BLOCK)
-        res[:, b] = _hc4_kernel(t.code, t.cst, t.outputs, lo[b], hi[b], np.ascontiguousarray(y[:, b]))
+        yb, mid = np.ascontiguousarray(y[:, b]), _mid(lo[b], hi[b], centred)
+        res[:, b] = _hc4_kernel(t.code, t.cst, t.outputs, lo[b], hi[b], yb, centred, mid)
     return res[0], res[1]
 
 
-def sep_box(t: Tape, lo: np.ndarray, hi: np.ndarray, y: np.ndarray) -> np.ndarray:
+def sep_box(t: Tape, lo: np.ndarray, hi: np.ndarray, y: np.ndarray, centred: bool = False) -> np.ndarray:
     """``(4, N, n)``: ``x_in`` (lo, hi) then ``x_out`` of the separator of ``f⁻¹([y])``, ``y (2, m)``."""
     lo, hi, yy = _c(lo), _c(hi), _c(y)[:, None, :]
     if lo.shape[0] <= BLOCK:
-        return _sep_box_kernel(t.code, t.cst, t.outputs, lo, hi, yy)
+        return _sep_box_kernel(t.code, t.cst, t.outputs, lo, hi, yy, centred, _mid(lo, hi, centred))
     res = np.empty((4, *lo.shape))
     for i in range(0, lo.shape[0], BLOCK):
         b = slice(i, i + BLOCK)
-        res[:, b] = _sep_box_kernel(t.code, t.cst, t.outputs, lo[b], hi[b], yy)
+        mid = _mid(lo[b], hi[b], centred)
+        res[:, b] = _sep_box_kernel(t.code, t.cst, t.outputs, lo[b], hi[b], yy, centred, mid)
     return res

@@ -5,8 +5,9 @@ per node, in topological order — and a ``float64`` array ``cst`` ``(K, 2)`` ho
 Compiled kernels (:mod:`.jit_hc4`) run the natural inclusion function (Eq. 2.21) and the projection
 rules of :mod:`.backward` on it, one box at a time in machine code. This module also holds the
 outward-rounded scalar interval operations those kernels need beyond :mod:`.jit` (empty =
-``(inf, -inf)``). Functions using an operation without a scalar rule (trigonometric, ``min``,
-``max``, ``atan2``) get no tape and keep the numpy path.
+``(inf, -inf)``; an operand with an infinite point gives the empty interval, :func:`.jit.nil`).
+Functions using an operation without a scalar rule (trigonometric, ``min``, ``max``, ``atan2``)
+get no tape and keep the numpy path.
 
 >>> t = Tape.of(Function(lambda x: (x[0] - 2) ** 2 + x[1]))
 >>> t.code[:, 0].tolist(), t.outputs.tolist()
@@ -27,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from .jit import add_dn, add_up, dn, imul, isqr, isqrt, mul_dn, mul_up, njit, up, wdn, wup
+from .jit import add_dn, add_up, dn, imul, isqr, isqrt, mul_dn, mul_up, nil, njit, up, wdn, wup
 
 _INF = math.inf
 VAR, CONST, ADD, SUB, MUL, DIV, NEG, SQR, SQRT, EXP, LOG, ABS, POWN = range(13)
@@ -69,7 +70,7 @@ class Tape:
 def meet(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     """``[a] ∩ [b]`` (Eq. 2.3)."""
     lo, hi = max(al, bl), min(ah, bh)
-    return (lo, hi) if lo <= hi else (_INF, -_INF)
+    return (lo, hi) if lo <= hi and lo < _INF and hi > -_INF else (_INF, -_INF)
 
 
 @njit(inline="always")
@@ -85,7 +86,7 @@ def _nan_hi(x: float) -> float:
 @njit(inline="always")
 def iadd(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     """``[a] + [b]`` (Eq. 2.5)."""
-    if al > ah or bl > bh:
+    if nil(al, ah) or nil(bl, bh):
         return _INF, -_INF
     return _nan_lo(add_dn(al, bl)), _nan_hi(add_up(ah, bh))
 
@@ -93,7 +94,7 @@ def iadd(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
 @njit(inline="always")
 def isub(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     """``[a] - [b]``."""
-    if al > ah or bl > bh:
+    if nil(al, ah) or nil(bl, bh):
         return _INF, -_INF
     return _nan_lo(add_dn(al, -bh)), _nan_hi(add_up(ah, -bl))
 
@@ -111,7 +112,7 @@ def _qup(a: float, b: float) -> float:
 @njit
 def ixdiv(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     """``[a]/[b]``, set-based (IEEE 1788), as :func:`.arith.div`: unbounded when ``0 ∈ [b]``."""
-    if al > ah or bl > bh or (bl == 0.0 and bh == 0.0):
+    if nil(al, ah) or nil(bl, bh) or (bl == 0.0 and bh == 0.0):
         return _INF, -_INF
     if bl > 0.0 or bh < 0.0:
         lo, hi = _INF, -_INF
@@ -140,7 +141,7 @@ def ixdiv(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
 @njit
 def iexp(al: float, ah: float) -> tuple[float, float]:
     """``exp([a])``, libm results widened by ``LIBM_ULPS``."""
-    if al > ah:
+    if nil(al, ah):
         return _INF, -_INF
     lo = 1.0 if al == 0.0 else max(wdn(math.exp(al)), 0.0)
     hi = 1.0 if ah == 0.0 else wup(math.exp(ah))
@@ -150,7 +151,7 @@ def iexp(al: float, ah: float) -> tuple[float, float]:
 @njit
 def ilog(al: float, ah: float) -> tuple[float, float]:
     """``log([a] ∩ (0, +∞))``; empty when ``[a] <= 0``."""
-    if al > ah or ah <= 0.0:
+    if nil(al, ah) or ah <= 0.0:
         return _INF, -_INF
     lo = -_INF if al <= 0.0 else (0.0 if al == 1.0 else wdn(math.log(al)))
     hi = 0.0 if ah == 1.0 else (_INF if ah == _INF else wup(math.log(ah)))
@@ -173,7 +174,7 @@ def _pow_pos(x: float, n: int, up: bool) -> float:
 @njit
 def ipown(al: float, ah: float, n: int) -> tuple[float, float]:
     """``[a]ⁿ`` for an integer ``n``, as :func:`.arith.pown`."""
-    if al > ah:
+    if nil(al, ah):
         return _INF, -_INF
     if n == 0:
         return 1.0, 1.0
@@ -191,10 +192,38 @@ def ipown(al: float, ah: float, n: int) -> tuple[float, float]:
 @njit(inline="always")
 def iabs(al: float, ah: float) -> tuple[float, float]:
     """``|[a]|``."""
-    if al > ah or al >= 0.0:
+    if nil(al, ah):
+        return _INF, -_INF
+    if al >= 0.0:
         return al, ah
     return (-ah, -al) if ah <= 0.0 else (0.0, max(-al, ah))
 
 
+@njit(inline="always", error_model="numpy")
+def fwd_op(op: int, al: float, ah: float, bl: float, bh: float, p: int) -> tuple[float, float]:
+    """Natural inclusion (Eq. 2.21) of one tape node ``op`` from its arguments' enclosures."""
+    if op == ADD:
+        return iadd(al, ah, bl, bh)
+    if op == SUB:
+        return isub(al, ah, bl, bh)
+    if op == MUL:
+        return imul(al, ah, bl, bh)
+    if op == DIV:
+        return ixdiv(al, ah, bl, bh)
+    if op == NEG:
+        return -ah, -al
+    if op == SQR:
+        return isqr(al, ah)
+    if op == SQRT:
+        return isqrt(al, ah)
+    if op == EXP:
+        return iexp(al, ah)
+    if op == LOG:
+        return ilog(al, ah)
+    if op == ABS:
+        return iabs(al, ah)
+    return ipown(al, ah, p)
+
+
 __all__ = ["Tape", "OPCODES", "up", "dn", "meet", "iadd", "isub", "imul", "ixdiv", "isqr", "isqrt", "iabs",
-           "iexp", "ilog", "ipown"]  # fmt: skip
+           "iexp", "ilog", "ipown", "fwd_op"]  # fmt: skip

@@ -20,7 +20,31 @@ Steps 1–3 run as one compiled call (:func:`.online_jit_step.filter_step`, the 
 :attr:`OnlineDigSlam.touched` grows by the smallest window holding the cells the step changed.
 
 State is a fixed set of arrays (plus a ring of ``W`` steps): memory does not grow with the episode.
-An empty box means the data contradict their bounds: the filter says so and stops (never a false claim).
+An empty box means the data contradict their bounds: the filter says so and stops, and withdraws its claims.
+
+**What is claimed, and when** (``q = 0``). If every interval of the records contains the truth, the true
+position lies in the box, every dug cell is free and every cell coded clear / dark was / was not sensed.
+If some reading misses the truth, the filter detects it only when the box becomes empty, which may happen
+later or never: until then that reading's claims stand, and one false long echo (or a range shifted up)
+digs false free space at once. The filter never reads the record's ``outlier`` flag.
+
+**q-relaxed mode** (``OnlineConfig(q=q)``, thesis §2.6.2, the relaxed intersection of Eq. 2.54). The premise
+becomes: *at most* ``q`` *of the range readings of each step* (per step, not per window of steps: the
+readings of different steps may hold ``q`` outliers each) miss the truth; the odometry, the compass and
+``X₀`` still hold. Then, for every step,
+
+* a cell is dug (``M⁻``) and certainly sensed (clear) only where at least ``q + 1`` readings of the step
+  prove it free (per cell and step: counted in one pass, then dug where the count reaches ``q + 1``); one
+  of them is an inlier, so the claim holds. With ``q >=`` the number of readings nothing is ever dug;
+* the impact contraction (Eq. 6.22) keeps the positions consistent with all but at most ``q`` echoes,
+  the hull of the q-relaxed intersection: ``dist(x, comp M⁻) <=`` the ``(q + 1)``-th smallest ``y⁺``
+  (:func:`.online_jit_pose.impact_bound_q`);
+* the possibly sensed zone grows with the maximum range ``r_max`` of every reading (an outlier's ``y⁺``
+  may be below the truth), so no dark cell was sensed.
+
+So up to ``q`` bad readings per step make no false claim at all. With more, the guarantee is that of
+``q = 0`` with bad data: an empty box is still reported (the filter stops and withdraws its claims), but
+claims made before that may be false. ``q = 0`` runs exactly the former kernels (bit for bit, same speed).
 
 >>> from digslam.observer.record import MissionRecord
 >>> def step(k):
@@ -48,10 +72,10 @@ import numpy as np
 from . import rounding as rnd
 from .grid import Grid
 from .online_explored import WindowDigMap
-from .online_jit_mark import dig_and_mark
+from .online_jit_mark import dig_and_mark_q
 from .online_jit_pose import cos_sin as _cos_sin  # noqa: F401  (re-exported: the tests use it)
-from .online_jit_pose import impact_bound
-from .online_jit_step import filter_step
+from .online_jit_pose import impact_bound_q
+from .online_jit_step import filter_step_q
 from .record import MissionRecord
 from .thick_sep import CLEAR, DARK, PENUMBRA
 
@@ -67,10 +91,14 @@ class OnlineConfig:
     Attributes:
         smoothing_window: fixed-lag backward smoothing over the last ``W`` steps (0 = off).
         impacts: apply the impact contractor (Eq. 6.22).
+        q: the q-relaxed mode (thesis §2.6.2): at most ``q`` of the range readings of ONE step are outliers
+            (their intervals may miss the truth; which ones is unknown). 0 (default): none, every claim as
+            in Algorithm 6.3. See the module docstring.
     """
 
     smoothing_window: int = 0
     impacts: bool = True
+    q: int = 0
 
     def __post_init__(self) -> None:
         w = self.smoothing_window
@@ -78,6 +106,8 @@ class OnlineConfig:
             raise ValueError(f"smoothing_window: must be an integer >= 0, got {w!r}")
         if not isinstance(self.impacts, bool | np.bool_):
             raise ValueError(f"impacts: must be a bool, got {self.impacts!r}")
+        if not (isinstance(self.q, int | np.integer) and not isinstance(self.q, bool) and self.q >= 0):
+            raise ValueError(f"q: must be an integer >= 0 (outliers allowed per step), got {self.q!r}")
 
     @classmethod
     def from_dict(cls, data: Any) -> OnlineConfig:
@@ -114,7 +144,7 @@ class OnlineDigSlam:
             raise ValueError(f"config: expected an OnlineConfig, got {type(config).__name__}")
         self.grid, self.config = grid, config or OnlineConfig()
         self._ring: deque = deque(maxlen=self.config.smoothing_window + 1)
-        self._impacts = bool(self.config.impacts)
+        self._impacts, self._q = bool(self.config.impacts), int(self.config.q)
         self._blank()
 
     def _blank(self) -> None:
@@ -123,6 +153,9 @@ class OnlineDigSlam:
         self.dig = WindowDigMap(self.grid)
         self.sensed_sure = np.zeros(self.grid.shape, dtype=bool)
         self.sensed_maybe = np.zeros(self.grid.shape, dtype=bool)
+        # per-cell reading counts and stamps of the q-relaxed mode (zero between steps; unused when q = 0)
+        self._cnt = np.zeros((2, *self.grid.shape) if self._q else (2, 1, 1), dtype=np.int32)
+        self._lst = np.zeros(self.grid.shape[0] * self.grid.shape[1] + 1 if self._q else 1, dtype=np.int32)
         self.consistent, self.inconsistent_step = False, None
         self.steps, self.last_update_seconds = 0, 0.0
         self._prev: MissionRecord | None = None
@@ -165,11 +198,12 @@ class OnlineDigSlam:
             return
         start = time.perf_counter()
         d, out = self.dig, np.empty(10)  # out: the new pose box, heading and displacement (fresh arrays)
-        code, r0, r1, c0, c1 = filter_step(d.free, self.sensed_sure, self.sensed_maybe, d.xs, d.ys, d.nys,
-                                           d.frame, self.pose_lo, self.pose_hi, self.heading_lo,
-                                           self.heading_hi, out, float(rec.t) - float(self._prev.t),
-                                           rec.yaw_rate, rec.heading, rec.speed, rec.alpha, rec.gamma,
-                                           rec.r_max, rec.range, rec.no_echo, self._impacts)  # fmt: skip
+        code, r0, r1, c0, c1 = filter_step_q(d.free, self.sensed_sure, self.sensed_maybe, d.xs, d.ys, d.nys,
+                                             d.frame, self.pose_lo, self.pose_hi, self.heading_lo,
+                                             self.heading_hi, out, float(rec.t) - float(self._prev.t),
+                                             rec.yaw_rate, rec.heading, rec.speed, rec.alpha, rec.gamma,
+                                             rec.r_max, rec.range, rec.no_echo, self._impacts, self._q,
+                                             self._cnt, self._lst)  # fmt: skip
         if code:
             return self._fail(start)
         self.pose_lo, self.pose_hi = out[0:2], out[2:4]
@@ -186,10 +220,10 @@ class OnlineDigSlam:
         return None
 
     # ------------------------------------------------------------------ internals
-    @staticmethod
-    def _impact_bound(rec: MissionRecord) -> float:
-        """Smallest upper range bound over the echoing sensors (``inf`` if none echoed)."""
-        return impact_bound(rec.no_echo, rec.range)
+    def _impact_bound(self, rec: MissionRecord) -> float:
+        """Radius of the impact constraint (Eq. 6.22): the ``(q + 1)``-th smallest upper range bound over the
+        echoing sensors (the smallest when ``q = 0``; ``inf`` if fewer echoed), :func:`.impact_bound_q`."""
+        return impact_bound_q(rec.no_echo, rec.range, self._q)
 
     def _fail(self, start: float) -> None:
         self.consistent, self.inconsistent_step = False, self.steps
@@ -200,12 +234,13 @@ class OnlineDigSlam:
 
     def _dig(self, rec: MissionRecord, lo: np.ndarray, hi: np.ndarray, psi: tuple[float, float],
              mark: bool = False) -> None:  # fmt: skip
-        """Eq. 6.21 for the readings of one step (the dug cells are certainly sensed: radius ``<= r_max``);
-        with ``mark``, grow the possibly sensed zone with the upper ranges (:mod:`.online_jit`)."""
-        d = self.dig
-        r0, r1, c0, c1 = dig_and_mark(d.free, self.sensed_sure, self.sensed_maybe, d.xs, d.ys, d.nys, lo[0],
-                                      lo[1], hi[0], hi[1], psi[0], psi[1], rec.alpha, rec.gamma, rec.r_max,
-                                      rec.range, mark)  # fmt: skip
+        """Eq. 6.21 for the readings of one step (the dug cells are certainly sensed: radius ``<= r_max``;
+        with ``q > 0`` only the cells proved free by ``q + 1`` of them); with ``mark``, grow the possibly
+        sensed zone with the upper ranges (``q > 0``: the maximum ranges), :func:`.dig_and_mark_q`."""
+        d, q = self.dig, self._q
+        r0, r1, c0, c1 = dig_and_mark_q(d.free, self.sensed_sure, self.sensed_maybe, self._cnt, self._lst,
+                                        d.xs, d.ys, d.nys, lo[0], lo[1], hi[0], hi[1], psi[0], psi[1],
+                                        rec.alpha, rec.gamma, rec.r_max, rec.range, mark, q)  # fmt: skip
         self._touch(r0, r1, c0, c1)
 
     def _touch(self, r0: int, r1: int, c0: int, c1: int) -> None:

@@ -11,6 +11,11 @@ enclosed by widened ``cos``/``sin``; a wider cone is covered by two cones of ape
 the proofs of :meth:`.digmap.DigMap.dig_sectors` and :meth:`~.digmap.DigMap.dig_disks`; every dug cell is
 also certainly sensed. The possibly sensed zone is in :mod:`.online_jit_mark`.
 
+In the q-relaxed mode of the filter (at most ``q`` outliers among the readings of one step, thesis §2.6.2,
+Eq. 2.54) a reading does not dig: :func:`_dig` with a reading stamp ``sid > 0`` counts, per cell, the readings
+of the step that prove it free, and :func:`.online_jit_mark.dig_and_mark_q` digs the cells counted
+``q + 1`` times (one of them at least is an inlier).
+
 Skipping a cell never makes a false claim here (it is just not dug), so the windows are float estimates
 padded by two cells; every claim is proved cell by cell.
 
@@ -132,10 +137,18 @@ def _axes(xs: np.ndarray, ys: np.ndarray, lo0: float, lo1: float, hi0: float, hi
 @njit
 def _dig_cone(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, nys: np.ndarray, lo0: float, lo1: float,
               hi0: float, hi1: float, t1: float, t2: float, r: float, disk: bool, ax: np.ndarray,
-              ay: np.ndarray, R0: int, C0: int) -> tuple[int, int, int, int]:  # fmt: skip
+              ay: np.ndarray, R0: int, C0: int, cnt: np.ndarray, lst: np.ndarray, sid: int
+              ) -> tuple[int, int, int, int]:  # fmt: skip
     """Dig the cells inside ``[x] + {ρ < r, θ ∈ [t1, t2]}`` (``disk``: the whole disk), ``t2 - t1 <= π``;
     ``ax``, ``ay``: :func:`_axes` of a window from row ``R0``, column ``C0`` holding the reading's window.
     Returns the window ``(r0, r1, c0, c1)`` of the cells it dug (empty: ``r0 >= r1``).
+
+    ``sid = 0`` digs (sets ``free`` and ``sure``). ``sid > 0`` (the q-relaxed mode, :func:`_dig` of reading
+    ``sid - 1``) only counts: each proved cell not yet in ``M⁻`` gets ``cnt[0] += 1`` once per reading
+    (``cnt[1]`` holds the reading that counted it last, so the two halves of a wide cone count once), a cell
+    counted for the first time in the step is appended to the list ``lst`` (``lst[0]`` its length, then
+    flat indices ``i·nx + j``), and the window returned is that of the counted cells; ``cnt`` is then
+    ``(2, ny, nx)`` and ``lst`` ``(ny·nx + 1,)``, else both unused.
 
     The bounds that depend on the column only (``p_x`` terms) or on the row only (``p_y`` terms) are
     computed once; each cell then compares them. A comparison ``a ≥ b`` of two bounds is exact, and so is
@@ -169,13 +182,26 @@ def _dig_cone(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, nys: np.ndarra
             dyl, dyh = ay[0, i - R0], ay[1, i - R0]
             cy1, cy2 = _plo(c1l, c1h, dyl, dyh), _phi(c2l, c2h, dyl, dyh)
         fr, sr = free[i, c0:c1], sure[i, c0:c1]  # row slices indexed from 0 (no wraparound checks)
+        if sid:
+            cc, cs = cnt[0, i, c0:c1], cnt[1, i, c0:c1]
+        else:
+            cc = cs = cnt[0, 0, 0:0]
         for k in range(n):
             if fr[k] or not fx2[k] + fy2 < r2:  # strictly inside the open disk, farthest corner
                 continue
             # min over the box of cross(e₁, p) = cos θ₁ p_y - sin θ₁ p_x >= 0, and of cross(p, e₂) >= 0
             if disk or (cy1 >= sx1[k] and sx2[k] >= cy2):
-                fr[k] = True
-                sr[k] = True
+                if sid:
+                    if cs[k] == sid:  # already counted for this reading (the other half of its cone)
+                        continue
+                    cs[k] = sid
+                    if cc[k] == 0:
+                        m = lst[0] + 1
+                        lst[0], lst[m] = m, i * free.shape[1] + c0 + k
+                    cc[k] += 1
+                else:
+                    fr[k] = True
+                    sr[k] = True
                 u0, u1, v0, v1 = min(u0, i), max(u1, i + 1), min(v0, c0 + k), max(v1, c0 + k + 1)
     return u0, u1, v0, v1
 
@@ -183,22 +209,27 @@ def _dig_cone(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, nys: np.ndarra
 @njit
 def _dig(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, nys: np.ndarray, lo0: float, lo1: float,
          hi0: float, hi1: float, psi_lo: float, psi_hi: float, alpha: float, gamma: float, r: float,
-         disk: bool, ax: np.ndarray, ay: np.ndarray, R0: int, C0: int
-         ) -> tuple[int, int, int, int]:  # fmt: skip
-    """:func:`dig_cells` on shared :func:`_axes`; returns the window of the dug cells (:func:`_dig_cone`)."""
+         disk: bool, ax: np.ndarray, ay: np.ndarray, R0: int, C0: int, cnt: np.ndarray, lst: np.ndarray,
+         sid: int) -> tuple[int, int, int, int]:  # fmt: skip
+    """:func:`dig_cells` on shared :func:`_axes`; returns the window of the dug cells (:func:`_dig_cone`;
+    ``sid > 0``: only count them in ``cnt`` and ``lst``, once for the reading ``sid``, the q-relaxed
+    mode)."""
     if not (math.isfinite(r) and r > 0.0):
         return 0, 0, 0, 0
     if disk:
-        return _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, 0.0, 0.0, r, True, ax, ay, R0, C0)
+        return _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, 0.0, 0.0, r, True, ax, ay, R0, C0, cnt,
+                         lst, sid)  # fmt: skip
     t1, t2 = sub_up(add_up(psi_hi, alpha), gamma), add_dn(add_dn(psi_lo, alpha), gamma)
     if not (math.isfinite(t1) and math.isfinite(t2) and t1 <= t2):
         return 0, 0, 0, 0
     if sub_up(t2, t1) > PI_DOWN:  # [θ₁, θ₁ + π⁻] and [θ₂ - π⁻, θ₂], both inside [θ₁, θ₂]
         t3, t4 = add_dn(t1, PI_DOWN), sub_up(t2, PI_DOWN)
-        a = _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, t1, t3, r, False, ax, ay, R0, C0)
-        b = _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, t4, t2, r, False, ax, ay, R0, C0)
+        a = _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, t1, t3, r, False, ax, ay, R0, C0, cnt, lst,
+                      sid)  # fmt: skip
+        b = _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, t4, t2, r, False, ax, ay, R0, C0, cnt, lst,
+                      sid)  # fmt: skip
         return union(a, b)
-    return _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, t1, t2, r, False, ax, ay, R0, C0)
+    return _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, t1, t2, r, False, ax, ay, R0, C0, cnt, lst, sid)
 
 
 @njit(inline="always")
@@ -240,7 +271,8 @@ def dig_cells(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, ys: np.ndarray
     if not (_box_ok(lo0, lo1, hi0, hi1) and math.isfinite(r) and r > 0.0):
         return
     ax, ay, R0, C0 = _reach_axes(xs, ys, nys, lo0, lo1, hi0, hi1, r)
-    _dig(free, sure, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha, gamma, r, disk, ax, ay, R0, C0)
+    _dig(free, sure, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha, gamma, r, disk, ax, ay, R0, C0,
+         np.zeros((2, 1, 1), np.int32), np.zeros(1, np.int32), 0)  # fmt: skip
 
 
 @njit

@@ -13,6 +13,8 @@ out means marked: a doubt never makes a cell dark.
 
 :func:`dig_and_mark` runs one step: :func:`.online_jit.dig_cells` for each reading's free range, then
 :func:`mark_cells` for its upper range, sharing the per-row / per-column bounds of the pose box.
+:func:`dig_and_mark_q` is the same step robust to at most ``q`` outliers among the step's readings
+(§2.6.2): a cell is dug where ``q + 1`` readings prove it free, ``Z⁺`` grows with the maximum ranges.
 
 >>> from digslam.observer.grid import Grid
 >>> g = Grid((-2.0, -2.0), (2.0, 2.0), (8, 8))
@@ -32,7 +34,7 @@ from .jit import add_dn, add_up, mul_up, njit, sub_dn, sub_up
 from .online_jit import _box_ok, _cone_window, _dig, _edge, _phi, _plo, _reach_axes, union, window
 from .rounding import HALF_PI_DOWN, PI_DOWN
 
-__all__ = ["mark_cells", "mark_batch", "dig_and_mark"]
+__all__ = ["mark_cells", "mark_batch", "dig_and_mark", "dig_and_mark_q"]
 
 
 @njit
@@ -115,21 +117,78 @@ def dig_and_mark(free: np.ndarray, sure: np.ndarray, maybe: np.ndarray, xs: np.n
     """One step's readings from one pose box: dig each free range ``min(y⁻, r_max)`` (``gamma >= π⁻`` is
     the omnidirectional disk); with ``mark``, grow ``Z⁺`` with ``min(y⁺, r_max)`` (``rng``: ``(n, 2)``).
     The per-row and per-column bounds (:func:`_axes`) are computed once for all the readings; returns the
-    smallest window ``(r0, r1, c0, c1)`` holding every cell changed (``(0, 0, 0, 0)`` when none)."""
+    smallest window ``(r0, r1, c0, c1)`` holding every cell changed (``(0, 0, 0, 0)`` when none).
+    :func:`dig_and_mark_q` with ``q = 0``."""
+    return dig_and_mark_q(free, sure, maybe, np.zeros((2, 1, 1), np.int32), np.zeros(1, np.int32), xs, ys,
+                          nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha, gamma, r_max, rng, mark,
+                          0)  # fmt: skip
+
+
+@njit
+def _settle(free: np.ndarray, sure: np.ndarray, cnt: np.ndarray, lst: np.ndarray, need: int
+            ) -> tuple[int, int, int, int]:  # fmt: skip
+    """Dig (``free``, ``sure``) the cells of the list ``lst`` (every cell counted in the step) counted at
+    least ``need`` times, then clear their counts and stamps and the list; returns the window of the dug
+    cells."""
+    nx = free.shape[1]
+    u0, u1, v0, v1 = free.shape[0], 0, nx, 0
+    for m in range(1, lst[0] + 1):
+        i, j = lst[m] // nx, lst[m] % nx
+        if cnt[0, i, j] >= need:
+            free[i, j] = True
+            sure[i, j] = True
+            u0, u1, v0, v1 = min(u0, i), max(u1, i + 1), min(v0, j), max(v1, j + 1)
+        cnt[0, i, j] = 0
+        cnt[1, i, j] = 0
+    lst[0] = 0
+    return u0, u1, v0, v1
+
+
+@njit
+def dig_and_mark_q(free: np.ndarray, sure: np.ndarray, maybe: np.ndarray, cnt: np.ndarray, lst: np.ndarray,
+                   xs: np.ndarray, ys: np.ndarray, nys: np.ndarray, lo0: float, lo1: float, hi0: float,
+                   hi1: float, psi_lo: float, psi_hi: float, alpha: np.ndarray, gamma: np.ndarray,
+                   r_max: np.ndarray, rng: np.ndarray, mark: bool, q: int
+                   ) -> tuple[int, int, int, int]:  # fmt: skip
+    """:func:`dig_and_mark` robust to at most ``q`` outliers among the ``n`` readings of this step.
+
+    ``q = 0``: every reading digs its free range (Eq. 6.21) and marks ``Z⁺`` with ``min(y⁺, r_max)``
+    (``cnt`` unused, e.g. ``(2, 1, 1)``).
+
+    ``q > 0`` (thesis §2.6.2, the q-relaxed intersection, Eq. 2.54, applied to the readings of ONE step):
+    each reading's free-range proof only counts, in ``cnt[0]`` (``(2, ny, nx)`` int32, zero between calls;
+    the counted cells listed in ``lst``, ``(ny·nx + 1,)`` int32, ``lst[0] = 0`` between calls), and a cell is
+    dug (``M⁻`` and certainly sensed ``Z⁻``) only where ``q + 1`` readings of the step prove it free: one of
+    them at least is an inlier, so the cell is free and was sensed. With ``q >= n`` nothing is dug.
+    An outlier's upper range can be below the truth, so ``Z⁺`` is grown with ``r_max`` for every reading:
+    the union over all the choices of at most ``q >= 1`` outliers (a true echo is within ``r_max``).
+    """
     if not _box_ok(lo0, lo1, hi0, hi1):
         return 0, 0, 0, 0
     reach = 0.0
     for k in range(alpha.size):
-        for r in (min(rng[k, 0], r_max[k]), min(rng[k, 1], r_max[k])):
+        rm = min(rng[k, 1], r_max[k]) if q == 0 else r_max[k]
+        for r in (min(rng[k, 0], r_max[k]), rm):
             if math.isfinite(r):
                 reach = max(reach, r)
     ax, ay, R0, C0 = _reach_axes(xs, ys, nys, lo0, lo1, hi0, hi1, reach)
     w = (0, 0, 0, 0)
-    for k in range(alpha.size):
-        w = union(w, _dig(free, sure, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha[k], gamma[k],
-                          min(rng[k, 0], r_max[k]), gamma[k] >= PI_DOWN, ax, ay, R0, C0))  # fmt: skip
+    if q == 0:
+        for k in range(alpha.size):
+            w = union(w, _dig(free, sure, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha[k], gamma[k],
+                              min(rng[k, 0], r_max[k]), gamma[k] >= PI_DOWN, ax, ay, R0, C0, cnt, lst,
+                              0))  # fmt: skip
+    elif alpha.size > q:  # with q >= n no cell can be proved by q + 1 readings
+        c = (0, 0, 0, 0)
+        for k in range(alpha.size):
+            c = union(c, _dig(free, sure, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha[k], gamma[k],
+                              min(rng[k, 0], r_max[k]), gamma[k] >= PI_DOWN, ax, ay, R0, C0, cnt, lst,
+                              k + 1))  # fmt: skip
+        if c[0] < c[1] and c[2] < c[3]:
+            w = union(w, _settle(free, sure, cnt, lst, q + 1))
     if mark:
         for k in range(alpha.size):
-            w = union(w, _mark(maybe, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha[k], gamma[k],
-                               min(rng[k, 1], r_max[k]), ax, ay, R0, C0))  # fmt: skip
+            rm = min(rng[k, 1], r_max[k]) if q == 0 else r_max[k]
+            w = union(w, _mark(maybe, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha[k], gamma[k], rm, ax,
+                               ay, R0, C0))  # fmt: skip
     return w

@@ -5,6 +5,8 @@ contractor on the cells of one pose box (Eq. 6.22), outward rounded with :mod:`.
   the slice ``[t_{k-1}, t_k]`` (both ends reachable, the gyro bounding the drift), and
   ``x_k ∈ x_{k-1} + [dt]·[v_k]·(cos, sin)([ψ] on the slice)``; every correctly rounded operation is
   stepped one ulp outward, ``cos``/``sin`` enclosed by :func:`cos_sin`.
+* :func:`impact_bound_q` is the radius of the impact constraint, q-relaxed (§2.6.2) when the filter allows
+  ``q`` outliers per step: the ``(q + 1)``-th smallest upper range.
 * :func:`clearance_cells` bounds ``dist(p, comp M⁻)`` from below for the cells of a pose box: the centre
   distance ``D`` to the nearest not-free cell of a window (the ring around the window counts as not free),
   then ``D(1 - EDT_SLACK) - diag`` (triangle inequality; the slack covers the rounding, as in
@@ -25,7 +27,7 @@ from .jit import dn, njit, up
 from .online_jit import window
 from .rounding import HALF_PI_DOWN, HALF_PI_UP
 
-__all__ = ["cos_sin", "predict", "clearance_cells", "contract", "impact_bound"]
+__all__ = ["cos_sin", "predict", "clearance_cells", "contract", "impact_bound", "impact_bound_q"]
 
 #: Absolute widening of a libm ``cos``/``sin`` value (``|v| <= 1``): 4 ulps of 1 plus the subtraction's.
 TRIG_PAD = 2e-15
@@ -192,3 +194,28 @@ def impact_bound(no_echo: np.ndarray, rng: np.ndarray) -> float:
         if not no_echo[k]:
             out = min(out, rng[k, 1])
     return out
+
+
+@njit
+def impact_bound_q(no_echo: np.ndarray, rng: np.ndarray, q: int) -> float:
+    """Radius of the q-relaxed impact constraint (Eq. 6.22 under thesis §2.6.2, Eq. 2.54): the ``(q + 1)``-th
+    smallest upper range bound over the echoing sensors (``inf`` if fewer than ``q + 1`` echoed).
+
+    Each echo ``k`` says an obstacle point lies within ``y_k⁺`` of the position, hence (outside ``M⁻``)
+    ``dist(x, comp M⁻) <= y_k⁺``. These sets are nested in ``y_k⁺``, so the points that satisfy all but at
+    most ``q`` of them, the q-relaxed intersection, are exactly ``dist(x, comp M⁻) <= y⁺_(q+1)``: with at
+    most ``q`` false echoes one of the ``q + 1`` smallest is true. ``q = 0`` is :func:`impact_bound`.
+    """
+    if q == 0:
+        return impact_bound(no_echo, rng)
+    best = np.full(q + 1, math.inf)  # the q + 1 smallest so far, increasing
+    for k in range(no_echo.size):
+        v = rng[k, 1]
+        if no_echo[k] or not v < best[q]:
+            continue
+        j = q
+        while j > 0 and best[j - 1] > v:
+            best[j] = best[j - 1]
+            j -= 1
+        best[j] = v
+    return best[q]

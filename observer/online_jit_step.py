@@ -9,6 +9,10 @@ Python, with the same arguments and the same results:
    :meth:`.online_explored.WindowDigMap.contract_box` does;
 3. :func:`.online_jit_mark.dig_and_mark`: digs ``M⁻`` (Eq. 6.21) and grows the explored zone (Eq. B.5).
 
+:func:`filter_step_q` takes ``q``, the number of outliers allowed among the step's range readings (thesis
+§2.6.2): step 2 then uses the q-relaxed impact radius and step 3 digs a cell only where ``q + 1`` readings
+prove it free; :func:`filter_step` is ``q = 0``.
+
 The new state is written into one ``float64`` array ``st`` of 10 values: the pose box ``x⁻, y⁻, x⁺, y⁺``,
 the heading ``ψ⁻, ψ⁺`` and the displacement box ``d_x⁻, d_y⁻, d_x⁺, d_y⁺``.
 Nothing is rounded here: every bound comes from those kernels (outward rounded with :mod:`.jit`).
@@ -32,20 +36,20 @@ import math
 import numpy as np
 
 from .jit import njit
-from .online_jit_mark import dig_and_mark
-from .online_jit_pose import contract, impact_bound, predict
+from .online_jit_mark import dig_and_mark_q
+from .online_jit_pose import contract, impact_bound_q, predict
 
-__all__ = ["filter_step"]
+__all__ = ["filter_step", "filter_step_q"]
 
 
 @njit
-def filter_step(free: np.ndarray, sure: np.ndarray, maybe: np.ndarray, xs: np.ndarray, ys: np.ndarray,
+def filter_step_q(free: np.ndarray, sure: np.ndarray, maybe: np.ndarray, xs: np.ndarray, ys: np.ndarray,
                 nys: np.ndarray, frame: np.ndarray, lo: np.ndarray, hi: np.ndarray, h_lo: float, h_hi: float,
                 st: np.ndarray, dt: float, yaw: np.ndarray,
                 comp: np.ndarray, speed: np.ndarray, alpha: np.ndarray, gamma: np.ndarray, r_max: np.ndarray,
-                rng: np.ndarray, no_echo: np.ndarray, impacts: bool
+                rng: np.ndarray, no_echo: np.ndarray, impacts: bool, q: int, cnt: np.ndarray, lst: np.ndarray
                 ) -> tuple[int, int, int, int, int]:  # fmt: skip
-    """Predict, contract and measure one step (see the module docstring).
+    """Predict, contract and measure one step (see the module docstring), robust to ``q`` outliers.
 
     Args:
         free, sure, maybe: ``(ny, nx)`` bool ``M⁻``, certainly and possibly sensed cells (updated in place).
@@ -57,6 +61,11 @@ def filter_step(free: np.ndarray, sure: np.ndarray, maybe: np.ndarray, xs: np.nd
         dt: the step's duration; yaw, comp, speed: ``(2,)`` yaw-rate, compass and speed intervals.
         alpha, gamma, r_max, rng, no_echo: the step's readings (``rng`` ``(n, 2)``).
         impacts: apply Eq. 6.22.
+        q: at most ``q`` of this step's range readings are outliers (0: none): the impact radius is the
+            q-relaxed :func:`.online_jit_pose.impact_bound_q` and a cell is dug where ``q + 1`` readings
+            prove it free (:func:`.online_jit_mark.dig_and_mark_q`).
+        cnt, lst: ``(2, ny, nx)`` and ``(ny·nx + 1,)`` int32 zeros, the per-cell counts and the list of the
+            counted cells of the q-relaxed mode (``q = 0``: unused).
 
     Returns:
         ``(code, r0, r1, c0, c1)``: ``code`` 0 and the window holding every changed cell, or ``code`` 1
@@ -68,7 +77,7 @@ def filter_step(free: np.ndarray, sure: np.ndarray, maybe: np.ndarray, xs: np.nd
     if not ok:
         return 1, 0, 0, 0, 0
     if impacts:
-        r_hi = impact_bound(no_echo, rng)
+        r_hi = impact_bound_q(no_echo, rng, q)
         if math.isfinite(r_hi) and frame[0] <= x0 <= x1 <= frame[2] and frame[1] <= y0 <= y1 <= frame[3]:
             x0, y0, x1, y1 = contract(free, xs, ys, nys, x0, y0, x1, y1, r_hi, frame[4], frame[5], frame[6],
                                       frame[7])  # fmt: skip
@@ -76,6 +85,19 @@ def filter_step(free: np.ndarray, sure: np.ndarray, maybe: np.ndarray, xs: np.nd
         return 1, 0, 0, 0, 0
     st[0], st[1], st[2], st[3], st[4], st[5] = x0, y0, x1, y1, hl, hh
     st[6], st[7], st[8], st[9] = d0l, d1l, d0h, d1h
-    r0, r1, c0, c1 = dig_and_mark(free, sure, maybe, xs, ys, nys, x0, y0, x1, y1, hl, hh, alpha, gamma,
-                                  r_max, rng, True)  # fmt: skip
+    r0, r1, c0, c1 = dig_and_mark_q(free, sure, maybe, cnt, lst, xs, ys, nys, x0, y0, x1, y1, hl, hh, alpha,
+                                    gamma, r_max, rng, True, q)  # fmt: skip
     return 0, r0, r1, c0, c1
+
+
+@njit
+def filter_step(free: np.ndarray, sure: np.ndarray, maybe: np.ndarray, xs: np.ndarray, ys: np.ndarray,
+                nys: np.ndarray, frame: np.ndarray, lo: np.ndarray, hi: np.ndarray, h_lo: float, h_hi: float,
+                st: np.ndarray, dt: float, yaw: np.ndarray,
+                comp: np.ndarray, speed: np.ndarray, alpha: np.ndarray, gamma: np.ndarray, r_max: np.ndarray,
+                rng: np.ndarray, no_echo: np.ndarray, impacts: bool
+                ) -> tuple[int, int, int, int, int]:  # fmt: skip
+    """:func:`filter_step_q` with ``q = 0`` (no outlier: every reading's interval contains the truth)."""
+    return filter_step_q(free, sure, maybe, xs, ys, nys, frame, lo, hi, h_lo, h_hi, st, dt, yaw, comp, speed,
+                         alpha, gamma, r_max, rng, no_echo, impacts, 0, np.zeros((2, 1, 1), np.int32),
+                         np.zeros(1, np.int32))  # fmt: skip

@@ -224,15 +224,23 @@ class SepBox(Sep):
         self.box, self.n = (ylo, yhi), ylo.shape[0]
 
     def pieces(self, lo: np.ndarray, hi: np.ndarray) -> list[Batch]:
-        """``[x] ∩ {y_k <= a_k}`` and ``[x] ∩ {y_k >= b_k}`` for every coordinate: the closed complement."""
+        """Boxes enclosing ``[x] ∩ {y_k < a_k}`` and ``[x] ∩ {y_k > b_k}`` for every coordinate ``k``.
+
+        The complement of ``[y] = [a, b]`` is open: each piece is the closed ``[x] ∩ {y_k <= a_k}``
+        (``>= b_k``), except that it is empty when ``x_k⁻ >= a_k`` (``x_k⁺ <= b_k``), for then no point
+        of ``[x]`` lies strictly beyond the bound (a box touching ``[y]`` from inside is not outside).
+        """
         out = []
         for k in range(self.n):
             for side in (0, 1):
                 plo, phi = lo.copy(), hi.copy()
                 if side == 0:
                     phi[:, k] = np.minimum(hi[:, k], self.box[0][k])
+                    none = lo[:, k] >= self.box[0][k]
                 else:
                     plo[:, k] = np.maximum(lo[:, k], self.box[1][k])
+                    none = hi[:, k] <= self.box[1][k]
+                plo[none], phi[none] = np.inf, -np.inf
                 out.append(normalize_empty(plo, phi))
         return out
 
@@ -241,8 +249,7 @@ class SepBox(Sep):
         xin = (np.full_like(lo, np.inf), np.full_like(hi, -np.inf))
         for p in self.pieces(lo, hi):
             xin = hull_batch(xin, p)
-        # a box with no point outside [y] but touching its border stays in x_in only where it
-        # actually meets the closed complement; interior boxes get an empty x_in
+        # a box inside [y], even touching its border, has no point outside: its x_in is empty
         return xin, xout
 
 

@@ -18,7 +18,9 @@ rounded to the nearest float64, which is how the ITF1788 plugins hand them to a 
 literals of the host language); ``infinity``; ``[empty]`` is ``(+inf, -inf)``; ``[entire]`` is
 ``(-inf, +inf)``; ``[x]`` is the point ``(x, x)``.
 
-Run ``python tests/itf1788.py [FOLDER]`` for a table of soundness and tightness per operation.
+Run ``python tests/itf1788.py [FOLDER]`` for a table of soundness and tightness per operation (FOLDER
+defaults to ``$DIGSLAM_ITF1788``); it exits 2 when no vector was checked (no folder, or no ``.itl`` file
+in it) and 1 when a result is unsound.
 """
 
 from __future__ import annotations
@@ -39,8 +41,21 @@ Operand = Interval | int | float
 EMPTY: Interval = (math.inf, -math.inf)
 ENTIRE: Interval = (-math.inf, math.inf)
 
-#: The default folder: ``<repo>/../shared/oracles/itf1788``.
-DEFAULT_FOLDER = Path(__file__).resolve().parents[1].parent / "shared" / "oracles" / "itf1788"
+#: Environment variable naming the folder of ``*.itl`` files (the ``itl/`` folder of the ITF1788 project).
+ENV_VAR = "DIGSLAM_ITF1788"
+#: The folder when ``DIGSLAM_ITF1788`` is unset: ``<repo>/../shared/oracles/itf1788``.
+FALLBACK_FOLDER = Path(__file__).resolve().parents[1].parent / "shared" / "oracles" / "itf1788"
+
+
+def vectors_folder() -> Path:
+    """``$DIGSLAM_ITF1788`` if set, else :data:`FALLBACK_FOLDER`."""
+    import os
+
+    env = os.environ.get(ENV_VAR)
+    return Path(env).expanduser() if env else FALLBACK_FOLDER
+
+
+DEFAULT_FOLDER = vectors_folder()
 
 
 class Vector(NamedTuple):
@@ -370,11 +385,16 @@ def table(results: dict[str, OpResult]) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
-    folder = Path(args[0]) if args else DEFAULT_FOLDER
+    folder = Path(args[0]) if args else vectors_folder()
+    how = (f"point {ENV_VAR} (or the first argument) at the itl/ folder of the ITF1788 test vectors "
+           "(oheim/ITF1788 on GitHub)")  # fmt: skip
     if not folder.is_dir():
-        print(f"no ITF1788 folder at {folder}", file=sys.stderr)
+        print(f"itf1788: no folder {folder}; {how}", file=sys.stderr)
         return 2
     results = run_all(folder)
+    if not sum(r.n_vectors for r in results.values()):
+        print(f"itf1788: no test vector checked in {folder} (no .itl file there); {how}", file=sys.stderr)
+        return 2
     print(table(results))
     bad = [(v, r) for res in results.values() for v, r in res.unsound]
     if bad:

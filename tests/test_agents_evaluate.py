@@ -77,14 +77,17 @@ def test_termination_pads_with_the_last_value_and_runs_are_deterministic() -> No
     np.testing.assert_array_equal(c, r2.curves["forward"])
 
 
-def test_record_episode_gif_uses_the_thesis_colours(tmp_path) -> None:  # type: ignore[no-untyped-def]
+def test_record_episode_gif_uses_the_pictures_palette(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from digslam.agents.pictures import MAP_SIZE, PALETTE, PANEL_WIDTH
+
     path = record_episode_gif(
-        _Forward(), path=tmp_path / "ep.gif", steps=12, seed=1, env_kwargs=SMALL, stride=3
+        _Forward(), path=tmp_path / "ep.gif", steps=12, seed=1, env_kwargs=SMALL, stride=3, scale=2
     )
     frames = iio.imread(path, index=None)
-    assert frames.shape == (5, 256, 256, 3)  # reset + steps 3, 6, 9, 12 (identical frames would merge)
-    colours = {tuple(c) for c in frames[-1].reshape(-1, 3)}
-    assert {(0xE4, 0x1A, 0x1C), (0x08, 0x30, 0x6B)} <= colours  # clear red, dark blue
+    assert frames.shape[0] == 5 and frames.shape[1:] == (MAP_SIZE // 2, (MAP_SIZE + PANEL_WIDTH) // 2, 3)
+    colours = {tuple(int(v) for v in c) for c in frames[-1].reshape(-1, 3)}
+    assert {PALETTE["clear"], PALETTE["dark"]} <= colours  # proved free is sky blue
+    assert (0xE4, 0x1A, 0x1C) not in colours  # never the old red
 
 
 def test_bad_input() -> None:

@@ -46,10 +46,16 @@ def test_demo_at_reduced_length(tmp_path, capsys) -> None:  # type: ignore[no-un
     assert 0.0 < float(line.split(":")[1].split()[0]) <= 1.0
 
 
-def test_demo_falls_back_to_frontier_without_the_model(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+def test_demo_falls_back_to_frontier_without_the_shipped_model(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    monkeypatch.setattr(cli, "PRETRAINED", tmp_path / "missing.zip")
     with pytest.warns(UserWarning, match="frontier"):
-        name, policy, _ = cli.resolve_agent("ppo", cli.DEFAULT_ENV, tmp_path / "missing.zip")
+        name, policy, _ = cli.resolve_agent("ppo", cli.DEFAULT_ENV, None)
     assert name == "frontier" and hasattr(policy, "predict")
+
+
+def test_a_named_model_that_cannot_load_is_an_error(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    with pytest.raises(cli.UserError, match="missing.zip: does not exist"):
+        cli.resolve_agent("ppo", cli.DEFAULT_ENV, tmp_path / "missing.zip")
 
 
 def test_record_replay_round_trip(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
@@ -77,7 +83,7 @@ def test_bad_arguments_are_reported(tmp_path, capsys) -> None:  # type: ignore[n
 
 def test_benchmark_runs_scripts_or_explains(monkeypatch, capsys) -> None:  # type: ignore[no-untyped-def]
     assert cli.main(["benchmark", "no_such_bench"]) == 2
-    assert "known:" in capsys.readouterr().out
+    assert "known:" in capsys.readouterr().err
     monkeypatch.setattr(cli, "benchmarks_dir", lambda: None)
     assert cli.main(["benchmark", "agents"]) == 2
-    assert "source checkout" in capsys.readouterr().out
+    assert "source checkout" in capsys.readouterr().err

@@ -9,15 +9,21 @@ from __future__ import annotations
 import functools
 import importlib.util
 import math
+import os
 import sys
 from pathlib import Path
 
 import pytest
 
-FOLDER = Path(__file__).resolve().parents[1].parent / "shared" / "oracles" / "itf1788"
+#: ``$DIGSLAM_ITF1788`` (the ``itl/`` folder of the ITF1788 test vectors), else ``<repo>/../shared/...``.
+FOLDER = Path(os.environ.get("DIGSLAM_ITF1788") or
+              Path(__file__).resolve().parents[1].parent / "shared" / "oracles" / "itf1788").expanduser()
 
 if not FOLDER.is_dir() or not any(FOLDER.glob("*.itl")):
-    pytest.skip(f"ITF1788 test vectors not found in {FOLDER}", allow_module_level=True)
+    if os.environ.get("DIGSLAM_ITF1788"):  # asked to check: finding nothing is a failure, not a skip
+        raise RuntimeError(f"DIGSLAM_ITF1788={os.environ['DIGSLAM_ITF1788']}: no .itl test vectors there")
+    pytest.skip(f"ITF1788 test vectors not found in {FOLDER}; set DIGSLAM_ITF1788 to their itl/ folder",
+                allow_module_level=True)
 
 
 def _load_parser():
