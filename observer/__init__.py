@@ -11,6 +11,20 @@ from . import arith, boxes, rounding, trig
 from .contractors import Ctc, CtcCompose, CtcFixPoint, CtcFwdBwd, CtcInter, CtcUnion
 from .digmap import DigMap
 from .digslam import DigSlamConfig, DigSlamResult, dig_slam
+from .explicit_slam import (
+    ExplicitSlamConfig,
+    ExplicitSlamResult,
+    MapFunction,
+    RangeMeasurements,
+    RasterShape,
+    SepShapeRegistration,
+    ShapeMeasurements,
+    ThickMap,
+    explicit_slam,
+    mission_tube,
+    shape_carve,
+    shape_register,
+)
 from .explored import (
     SepExploredDisks,
     explored_disks_grid,
@@ -126,6 +140,9 @@ __all__ = [
     "thick_product", "OnlineConfig", "OnlineDigSlam",
     "SepTranslationInclusion", "ThickImage", "level_thick_image", "register_translation", "ShapeSlamConfig",
     "ShapeSlamResult", "ctc_minus", "overlap_pretest", "shape_slam",
+    "ExplicitSlamConfig", "ExplicitSlamResult", "MapFunction", "RangeMeasurements", "RasterShape",
+    "SepShapeRegistration", "ShapeMeasurements", "ThickMap", "explicit_slam", "mission_tube", "shape_carve",
+    "shape_register",
     "CLEAR", "DARK", "PENUMBRA", "UNKNOWN", "ThickSep", "thick_classify_grid", "thick_relaxed_intersection",
     "ctc_equal", "ctc_subset", "ThickFunction", "ThickIntervalArray", "thin",
     "SepSubpaving", "load", "save", "simplify",

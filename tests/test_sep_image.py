@@ -65,13 +65,14 @@ def test_separation_invariant_and_exact_soundness(outside: bool) -> None:
     for r in range(len(lo) - 3):
         for p in (rng.uniform(lo[r], hi[r]), lo[r], hi[r], np.array([lo[r, 0], hi[r, 1]])):
             fx, fy = (Fraction(float(p[0])) - fx0) / fex, (fy0 - Fraction(float(p[1]))) / fey
-            # closed pixels: a point on a border belongs to every pixel it touches
+            # the set is the union of the CLOSED set pixels (a point on a border belongs to every pixel it
+            # touches), so its complement is open: a border point touching a set pixel is in the set
             js, is_ = ({math.floor(f), math.ceil(f) - 1} for f in (fx, fy))
             vals = {bool(RNG_IMG[i, j]) if 0 <= i < h and 0 <= j < w else outside for i in is_ for j in js}
             inside = (xout[0][r] <= p).all() and (p <= xout[1][r]).all()
             in_comp = (xin[0][r] <= p).all() and (p <= xin[1][r]).all()
-            assert inside or True not in vals, (r, p)
-            assert in_comp or False not in vals, (r, p)
+            assert inside or True not in vals, (r, p)  # a point of the set is in x_out
+            assert in_comp or True in vals, (r, p)  # a point outside the set is in x_in
 
 
 def test_outside_option() -> None:
