@@ -18,14 +18,17 @@ from typing import Any
 
 import numpy as np
 
+from digslam.envs.dig_coverage import RGB
+from digslam.observer.thick_sep import CLEAR, DARK, PENUMBRA
+
 MAP_SIZE = 512
 PANEL_WIDTH = 320
 #: Palette indices and colours (Okabe-Ito, plus black and white).
 PALETTE: dict[str, tuple[int, int, int]] = {
     "background": (255, 255, 255),
-    "clear": (86, 180, 233),  # sky blue
-    "penumbra": (230, 159, 0),  # orange
-    "dark": (38, 38, 56),  # near black
+    "clear": RGB[int(CLEAR)],  # sky blue: the env's render and the GIF share the sets' colours
+    "penumbra": RGB[int(PENUMBRA)],  # orange
+    "dark": RGB[int(DARK)],  # near black
     "obstacle": (150, 150, 150),  # grey
     "echo": (213, 94, 0),  # vermillion
     "robot": (0, 158, 115),  # bluish green
@@ -202,8 +205,8 @@ def demo_episode(
     scale: int = 1,
 ) -> Any:
     """Run one episode of ``policy``, write its GIF to ``path`` (every ``stride``-th step and the last, each
-    frame shrunk ``scale`` times) and return its :class:`~digslam.agents.evaluate.EvalResult` (one episode, curves padded after an early end,
-    ``lengths`` the steps run)."""
+    frame shrunk ``scale`` times) and return its :class:`~digslam.agents.evaluate.EvalResult` (one
+    episode, curves padded after an early end, ``lengths`` the steps run)."""
     from .evaluate import EvalResult, _make_env
 
     for key, v in (("steps", steps), ("fps", fps), ("stride", stride), ("scale", scale)):

@@ -8,8 +8,9 @@ The raw :class:`~.explore_env.ExploreEnv` under a :class:`~.observer_wrapper.Gua
   8-connected to the start, computed once per world) reaches ``target``; truncation at the registered step
   limit (``TimeLimit``) or when the observer finds the data inconsistent (its claims are then withdrawn);
 * ``info``: the observer's sets and both coverages, certified and ground truth (``true_coverage``);
-* ``render``: the thesis colours (clear red, penumbra orange, dark blue; obstacles grey) with the pose box
-  (black) and the true robot (green).
+* ``render``: the colour-blind-safe palette of the demo's pictures (Okabe and Ito: clear sky blue,
+  penumbra orange, dark near black; obstacles grey) with the pose box (black) and the true robot (green).
+  Proved-free space is never red (the thesis's figures use red for it, which invites the opposite reading).
 
 ``digslam/DigCoverageOutliers-v0`` is this env on the rocks world with unflagged outliers, at most one per
 step (``noise.max_outliers = 1``), and the observer's q-relaxed mode at ``q = 1`` (thesis §2.6.2): no false
@@ -40,11 +41,11 @@ from .observer_config import DigCoverageConfig
 from .observer_wrapper import GuaranteedObserver
 from .raster import FREE, rasterize
 
-#: Thesis colours (``digslam.observer.draw``: CLEAR_COLOR, PENUMBRA_COLOR, DARK_COLOR) as RGB.
+#: Colours of the sets as RGB (Okabe-Ito, as ``digslam.agents.pictures.PALETTE``).
 RGB = {
-    int(CLEAR): (0xE4, 0x1A, 0x1C),
-    int(PENUMBRA): (0xFF, 0x8C, 0x00),
-    int(DARK): (0x08, 0x30, 0x6B),
+    int(CLEAR): (86, 180, 233),  # sky blue
+    int(PENUMBRA): (230, 159, 0),  # orange
+    int(DARK): (38, 38, 56),  # near black
 }
 OBSTACLE_RGB = (150, 150, 160)
 RENDER_SIZE = 512

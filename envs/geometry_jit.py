@@ -224,8 +224,8 @@ def _edge_cone(ax: float, ay: float, dx: float, dy: float, px: np.ndarray, py: n
 def sector_bounds_kernel(x: float, y: float, th: float, alpha: np.ndarray, gamma: np.ndarray,
                          edges: np.ndarray, bbox: np.ndarray, reach: float, perr: float,
                          out: np.ndarray) -> None:  # fmt: skip
-    """Rigorous bounds ``out[s] = (lo, hi)``, ``lo <= d_s <= hi``, of the true distance ``d_s`` from the true position to the
-    nearest obstacle point of sector ``s`` (thesis Eq. 4.22), written in place.
+    """Rigorous bounds ``out[s] = (lo, hi)``, ``lo <= d_s <= hi``, of the true distance ``d_s`` from the true
+    position to the nearest obstacle point of sector ``s`` (thesis Eq. 4.22), written in place.
 
     The true heading is ``th`` exactly (:mod:`.arc`); the true position lies within ``perr`` of ``(x, y)``
     in each coordinate (the simulator's accumulated bound). Three effects are bounded:

@@ -195,7 +195,7 @@ def test_vector_env() -> None:
     envs.close()
 
 
-def test_render_uses_the_thesis_colours() -> None:
+def test_render_uses_the_colour_blind_safe_palette() -> None:
     env = gym.make("digslam/DigCoverage-v0", render_mode="rgb_array", map_size=36)
     env.reset(seed=0)
     for a in _actions(5):
@@ -203,8 +203,9 @@ def test_render_uses_the_thesis_colours() -> None:
     img = env.render()
     colours = {tuple(c) for c in img.reshape(-1, 3)}
     assert (
-        img.shape == (512, 512, 3) and {(0xE4, 0x1A, 0x1C), (0xFF, 0x8C, 0x00), (0x08, 0x30, 0x6B)} <= colours
+        img.shape == (512, 512, 3) and {(86, 180, 233), (230, 159, 0), (38, 38, 56)} <= colours
     )
+    assert (0xE4, 0x1A, 0x1C) not in colours  # proved free is never red
     assert (20, 160, 60) in colours and (0, 0, 0) in colours  # the true robot and the pose box
 
 
