@@ -172,10 +172,15 @@ def cover_update(free: np.ndarray, seen: np.ndarray, xs: np.ndarray, ys: np.ndar
     """:func:`cover_kernel` on the window of cells within reach of ``pose`` ``(x, y, theta)``: ``win`` is
     ``(x0, y0, dx, dy, kx, ky)``, the grid's lower-left corner, its cell sides and the reach in cells; the
     window is the ``(2 ky + 1) x (2 kx + 1)`` cells around the pose's cell (one call per step, no Python
-    arithmetic)."""
+    arithmetic), narrowed to this step's farthest reading: no cell centre beyond ``max_s min(range_s,
+    r_max_s)`` can be marked."""
     x, y, th = pose[0], pose[1], pose[2]
     ny, nx = free.shape
-    kx, ky = int(win[4]), int(win[5])
+    far = 0.0
+    for s in range(ranges.shape[0]):
+        far = max(far, min(ranges[s], r_max[s]))
+    kx = min(int(win[4]), int(math.ceil(far / win[2])) + 1)
+    ky = min(int(win[5]), int(math.ceil(far / win[3])) + 1)
     ic, jc = int(math.floor((y - win[1]) / win[3])), int(math.floor((x - win[0]) / win[2]))
     i0, i1, j0, j1 = max(ic - ky, 0), min(ic + ky + 1, ny), max(jc - kx, 0), min(jc + kx + 1, nx)
     return cover_kernel(free, seen, xs, ys, i0, i1, j0, j1, x, y, th, breaks, cover, ranges, r_max)

@@ -105,6 +105,7 @@ from .thick_sep import (
 )
 from .thick_set import ctc_equal, ctc_subset
 from .thick_sivia import ThickInverse, thick_sivia
+from .thick_subset import SubsetSupsetArray, ThickInverseSubsetSupset, thick_sivia_subset_supset
 from .transforms import CtcTransform, SepTransform, Transform, symmetric_union
 from .tube import (
     Tube,
@@ -129,6 +130,7 @@ __all__ = [
     "sep_landmark_fwdbwd",
     "SepFixedParam", "thick_inverse_classical", "thick_inverse_proj", "ThickPaving", "ThickTest",
     "thick_pave", "ThickInverse", "thick_sivia",
+    "SubsetSupsetArray", "ThickInverseSubsetSupset", "thick_sivia_subset_supset",
     "Tube", "body_velocity", "ctc_deriv", "dead_reckoning", "heading_from_compass", "heading_from_gyro",
     "unicycle_velocity", "Grid", "DigMap", "DigSlamConfig", "DigSlamResult", "dig_slam",
     "SepExploredDisks", "explored_disks_grid", "explored_disks_thick_sep", "explored_hypotheses",

@@ -203,7 +203,13 @@ class Function:
         self.var_nodes = {p: i for i, (op, _, p) in enumerate(self.nodes) if op == "var"}
 
     def _topo(self, root: Expr, index: dict[Any, int], seen: dict[int, int]) -> int:
-        """Append the nodes under ``root`` (iterative post-order, identical sub-DAGs merged)."""
+        """Append the nodes under ``root`` (iterative post-order, identical sub-DAGs merged).
+
+        Two *distinct* interval constants with width stay distinct nodes even when their intervals are
+        equal: each stands for its own unknown value in the interval, and the backward pass contracts a
+        node from all its uses, so merging them would couple them (an unsound contraction, e.g. ``sin`` and
+        ``cos`` of a bearing in ``[42°, 48°]`` give the same interval). The same constant object used twice
+        is one value and one node; point constants merge freely."""
         stack: list[tuple[Expr, bool]] = [(root, False)]
         while stack:
             e, done = stack.pop()
@@ -214,10 +220,13 @@ class Function:
                 stack.extend((a, False) for a in e.args if id(a) not in seen)
                 continue
             key = (e.op, tuple(seen[id(a)] for a in e.args), e.param)
-            if key not in index:
-                index[key] = len(self.nodes)
+            ikey: Any = key
+            if e.op == "const" and e.param[0] != e.param[1]:
+                ikey = (key, id(e))  # an uncertain constant: its own node (see above)
+            if ikey not in index:
+                index[ikey] = len(self.nodes)
                 self.nodes.append(key)
-            seen[id(e)] = index[key]
+            seen[id(e)] = index[ikey]
         return seen[id(root)]
 
     def __repr__(self) -> str:
