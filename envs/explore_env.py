@@ -179,6 +179,17 @@ class ExploreEnv(gym.Env):
             self._renderer.close()
             self._renderer = None
 
+    def measure_coverage_on(self, coverage: Coverage) -> None:
+        """Measure the ground-truth coverage (the reward, ``info["coverage"]`` and termination) on
+        ``coverage``'s cells until the next reset, instead of the world's whole free raster.
+
+        The certified-coverage wrapper passes the reachable free cells of its grid (already updated with
+        the reset's readings), so that one compiled update a step serves both the raw env and the wrapper's
+        ``true_coverage``, and both speak of the same area as the certified coverage."""
+        if self.sim is None:
+            raise RuntimeError("measure_coverage_on: call reset() first")
+        self.coverage = coverage
+
     # --- pieces of step ------------------------------------------------------------------------------------
     def _check_action(self, action: np.ndarray) -> tuple[float, float]:
         a = np.asarray(action)

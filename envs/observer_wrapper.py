@@ -204,10 +204,10 @@ class GuaranteedObserver(gym.Wrapper):
         self.filter.reset(lo, hi, info["record"])
         self.steps, self._cache_step = 0, -1
         # ground truth over the cells of the certified coverage, the reachable free area (:mod:`.coverage`)
-        self._suite = raw.suite
         self.truth_coverage = Coverage.on_cells(self.reachable[::-1], self.grid.lo, self.grid.cell_size,
                                                 float(raw.suite.r_max.max()))  # fmt: skip
         self.truth_coverage.update(truth.pose, raw.suite, truth.ranges)
+        raw.measure_coverage_on(self.truth_coverage)  # the raw env updates it each step (its reward too)
         self.monitor = (GuaranteeMonitor(raw.world, self.grid, coverage=(self.reachable, self.truth_coverage))
                         if self.obs_config.monitor else None)  # fmt: skip
         self._check(info)
@@ -217,7 +217,6 @@ class GuaranteedObserver(gym.Wrapper):
     def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         step = self.env._step(action, observe=False) if self._fast else self.env.step(action)
         _, reward, terminated, truncated, info = step
-        self.truth_coverage.update(info["truth"].pose, self._suite, info["truth"].ranges)
         self.filter.update(info["record"])  # :meth:`_feed`, inlined
         self.steps += 1
         if self.monitor is not None:
