@@ -56,7 +56,7 @@ _ES0 = (2 * LIBM_ULPS + 12) * _U
 _EC0 = 2 * LIBM_ULPS * _U
 
 
-@njit(inline="always")
+@njit
 def arc_move(x: float, y: float, th0: float, th1: float, v: float, tau: float) -> tuple[float, float, float]:
     """Position after a piece of (A) and the bound ``E`` on each coordinate's error; see the module.
 
@@ -85,7 +85,7 @@ def arc_move(x: float, y: float, th0: float, th1: float, v: float, tau: float) -
     return x1, y1, 2.0 * add_up(big, tail)
 
 
-@njit(inline="always")
+@njit
 def advance(x: float, y: float, th: float, v: float, w: float,
             tau: float) -> tuple[float, float, float, float]:  # fmt: skip
     """One piece at commanded ``(v, w)`` for ``tau`` s: ``(x₁, y₁, θ₁, E)`` with ``θ₁ = fl(θ + w τ)`` exact
@@ -95,7 +95,7 @@ def advance(x: float, y: float, th: float, v: float, w: float,
     return x1, y1, th1, e
 
 
-@njit(inline="always")
+@njit
 def yaw_rate_bounds(th0: float, th1: float, tau: float) -> tuple[float, float]:
     """Outward bounds of the true yaw rate ``(θ₁ − θ₀)/τ`` of a piece (``tau > 0``)."""
     d_lo, d_hi = sub_dn(th1, th0), sub_up(th1, th0)
