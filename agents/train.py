@@ -22,6 +22,8 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
+import signal
+import threading
 import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, fields
@@ -280,12 +282,24 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = N
     ``callbacks`` are extra SB3 callbacks given to ``learn`` (e.g. the Ray Tune reporter of
     :mod:`.sweep`). ``worker_guard`` is a context manager held while the worker processes start (the
     command line's ignores SIGINT there, so Ctrl-C reaches the main process only). Ctrl-C during ``learn``
-    saves the model so far to ``<out_dir>/interrupted_model.zip`` and raises :class:`TrainingInterrupted`.
+    saves the model so far to ``<out_dir>/interrupted_model.zip`` and raises :class:`TrainingInterrupted`:
+    in the main thread SIGINT only sets a flag that a callback reads at the next environment step, so the
+    signal never lands inside a kernel being compiled or a half-done update.
 
     ``out_dir`` also gets ``config.json``, ``checkpoints/``, ``tb/`` (TensorBoard), and with evaluation
     ``best_model.zip`` and ``eval/evaluations.npz`` (held-out maps ``cfg.eval_seeds()``).
     """
-    from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
+    from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
+
+    class _StopOnSigint(BaseCallback):  # type: ignore[misc]
+        """Stops ``learn`` at the next step once SIGINT has set the flag."""
+
+        def __init__(self) -> None:
+            super().__init__()
+            self.flag = False
+
+        def _on_step(self) -> bool:
+            return not self.flag
 
     pin_threads(cfg.torch_threads)
     out = Path(cfg.out_dir)
@@ -326,9 +340,18 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = N
         bar = _has_progress() and cfg.progress_bar
         with warnings.catch_warnings():  # Subproc training env vs Dummy eval env is intended
             warnings.filterwarnings("ignore", message="Training and eval env are not of the same type")
+            stop = _StopOnSigint()
+            main = threading.current_thread() is threading.main_thread()
+            old = signal.signal(signal.SIGINT, lambda *_: setattr(stop, "flag", True)) if main else None
             try:
-                model.learn(cfg.total_timesteps, callback=callbacks, progress_bar=bar)
+                model.learn(cfg.total_timesteps, callback=[*callbacks, stop], progress_bar=bar)
+                interrupted = stop.flag
             except KeyboardInterrupt:
+                interrupted = True
+            finally:
+                if main:
+                    signal.signal(signal.SIGINT, old)
+            if interrupted:
                 path = out / "interrupted_model.zip"
                 _save(model, path)
                 raise TrainingInterrupted(path, int(model.num_timesteps)) from None
