@@ -3,8 +3,10 @@
 Names are imported on first use, so ``import digslam.agents`` needs neither torch nor stable-baselines3
 (those are imported inside the functions that train or load a learned policy).
 
-``digslam.agents.evaluate`` is the evaluation module (a submodule always shadows a package attribute of
-the same name once imported); its function is exported as :func:`evaluate_agents` too.
+Folders: :mod:`~digslam.agents.baselines` (heuristic agents), :mod:`~digslam.agents.learning` (training,
+sweeps, the shipped model), :mod:`~digslam.agents.evaluation` (evaluation, pictures) and
+:mod:`~digslam.agents.cli` (the command line, the only place that wires argparse). The evaluation function
+is exported as :func:`evaluate_agents` (``digslam.agents.evaluation.evaluate`` is its module).
 """
 
 from __future__ import annotations
@@ -12,9 +14,20 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-from . import origin as _origin
+from digslam.observer.core import compat as _compat
+from digslam.observer.core import origin as _origin
 
 _origin.warn_if_shadowed(__name__)
+
+#: Modules that moved into the concept folders: old name -> new path (the old path warns, for one release).
+MOVED = {
+    "policy": "baselines.policy", "planning": "baselines.planning", "frontier": "baselines.frontier",
+    "train": "learning.train", "extractor": "learning.extractor", "sweep": "learning.sweep",
+    "sweep_config": "learning.sweep_config", "evaluate": "evaluation.evaluate",
+    "pictures": "evaluation.pictures",
+    "ray_eval": "evaluation.ray_eval", "warmup": "cli.warmup", "origin": "digslam.observer.core.origin",
+}  # fmt: skip
+_compat.install_aliases(__name__, MOVED)
 
 #: Public names and the submodule that defines each.
 _LAZY = {
@@ -25,10 +38,10 @@ _LAZY = {
     "RandomAgent": "baselines",
     "UncertaintyAwareFrontier": "baselines",
     "make_baseline": "baselines",
-    "EvalResult": "evaluate",
-    "coverage_figure": "evaluate",
-    "evaluate_agents": "evaluate",
-    "record_episode_gif": "evaluate",
+    "EvalResult": "evaluation.evaluate",
+    "coverage_figure": "evaluation.evaluate",
+    "evaluate_agents": "evaluation.evaluate",
+    "record_episode_gif": "evaluation.evaluate",
 }
 
 

@@ -1,6 +1,6 @@
 """Certified coverage of the coverage agents on held-out maps of ``digslam/DigCoverage-v0``.
 
-Every baseline of :data:`digslam.agents.baselines.BASELINES` (and the PPO policy
+Every baseline of :data:`digslam.agents.baselines.registry.BASELINES` (and the PPO policy
 ``agents/data/ppo_digcoverage.zip`` when it exists, on the env keywords of its ``.json`` sidecar: they
 change the observation, not the maps) runs on the same ``--maps`` maps, map ``i`` being
 ``reset(seed=--seed + i)`` with the world regenerated, for ``--steps`` steps. The env keeps its defaults,
@@ -26,8 +26,8 @@ from typing import Any
 import gymnasium as gym
 
 import digslam.envs  # noqa: F401  (registers the environments)
-from digslam.agents.baselines import BASELINES, make_baseline
-from digslam.agents.evaluate import EvalResult, coverage_figure, evaluate
+from digslam.agents.baselines.registry import BASELINES, make_baseline
+from digslam.agents.evaluation.evaluate import EvalResult, coverage_figure, evaluate
 
 ENV_ID = "digslam/DigCoverage-v0"
 MODEL = Path(__file__).resolve().parents[1] / "agents" / "data" / "ppo_digcoverage.zip"

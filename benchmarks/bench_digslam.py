@@ -16,10 +16,10 @@ import time
 
 import numpy as np
 
-from digslam.envs.generators import ThesisRoom
-from digslam.envs.missions import loop_mission
-from digslam.observer.digslam import dig_slam
-from digslam.observer.grid import Grid
+from digslam.envs.sim.missions import loop_mission
+from digslam.envs.world.generators import ThesisRoom
+from digslam.observer.slam.digslam import dig_slam
+from digslam.observer.slam.grid import Grid
 
 
 def main() -> None:
@@ -39,8 +39,10 @@ def main() -> None:
     print(f"samples: {len(record)}  iterations: {res.iterations}  truth in tube: {bool(inside)}")
     print(f"dead reckoning width: max {res.dead_reckoning.max():.3f} m, final {res.dead_reckoning[-1]:.3f} m")
     for i, w in enumerate(res.widths):
-        print(f"iteration {i + 1}: max width before {w['before'].max():.3f} m, after impacts "
-              f"{w['impacts'].max():.3f} m, after C_d/dt {w['deriv'].max():.3f} m (mean {w['deriv'].mean():.3f})")
+        print(
+            f"iteration {i + 1}: max width before {w['before'].max():.3f} m, after impacts "
+            f"{w['impacts'].max():.3f} m, after C_d/dt {w['deriv'].max():.3f} m (mean {w['deriv'].mean():.3f})"
+        )
     print(f"dig zone: {res.dig.free.sum() * 0.05**2:.1f} m²; times: {', '.join(f'{t:.2f}' for t in times)} s")
     print(f"seconds={float(np.median(times)):.3f}")
 

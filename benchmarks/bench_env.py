@@ -23,7 +23,7 @@ import numpy as np
 import pymunk
 
 import digslam.envs  # noqa: F401  (registers the environments)
-from digslam.envs.robot import RobotSim
+from digslam.envs.sim.robot import RobotSim
 
 RAYS_PER_CONE = 5
 
@@ -134,7 +134,9 @@ def main() -> None:
     print(
         f"ours_steps_per_s={o:.0f}  (exact cones, noise, record, truth, coverage reward; gym.make wrappers)"
     )
-    print(f"ours_unwrapped_steps_per_s={float(np.median(raw)):.0f}  (the same env without gym.make's wrappers)")
+    print(
+        f"ours_unwrapped_steps_per_s={float(np.median(raw)):.0f}  (the same env without gym.make's wrappers)"
+    )
     print(
         f"reference_steps_per_s={r:.0f}  "
         f"(pymunk, {RAYS_PER_CONE} rays/cone segment_query_first + omni nearest)"

@@ -47,8 +47,12 @@ def main() -> None:
     ap.add_argument("--eps", type=float, nargs="+", default=[0.1, 0.01, 0.001])
     ap.add_argument("--problems", nargs="+", default=["ring", "ex26"])
     ap.add_argument("--repeat", type=int, default=3, help="best of N for ours")
-    ap.add_argument("--ratio", type=float, default=0.49,
-                    help="bisection ratio (default 0.49, codac's own cut, so both pavers build the same tree)")
+    ap.add_argument(
+        "--ratio",
+        type=float,
+        default=0.49,
+        help="bisection ratio (default 0.49, codac's own cut, so both pavers build the same tree)",
+    )
     ap.add_argument("--kappa", type=float, default=None, help="ours with cut='grid', max_volume=kappa*eps**2")
     args = ap.parse_args()
     worst = 0.0

@@ -21,7 +21,7 @@ import numpy as np
 from _peer import codac
 
 from digslam.observer import Box, pave
-from digslam.observer.polar_sep import SepLandmark, sep_landmark_fwdbwd
+from digslam.observer.polar.sep import SepLandmark, sep_landmark_fwdbwd
 
 FRAME = Box([(-6, 4), (-6, 4)])
 ARGS = ((0.0, 0.0), (4.0, 6.0), (-np.pi / 12, np.pi / 4))

@@ -1,8 +1,8 @@
 """Distributed evaluation on Ray against the sequential one (issue 11).
 
 Evaluates ``--episodes`` episodes (maps ``seed, seed + 1, ...``) of the frontier agent, ``--steps`` steps
-each (``--target 1.0`` by default, so no episode ends early), twice in one run: sequentially with :func:`digslam.agents.evaluate.evaluate`, then with
-:func:`digslam.agents.ray_eval.evaluate_ray` on a local Ray instance with ``--workers`` CPUs (one task per
+each (``--target 1.0`` by default, so no episode ends early), twice in one run: sequentially with :func:`digslam.agents.evaluation.evaluate.evaluate`, then with
+:func:`digslam.agents.evaluation.ray_eval.evaluate_ray` on a local Ray instance with ``--workers`` CPUs (one task per
 episode). The Ray time counts everything: starting the instance, the workers' imports, the episodes and
 the shutdown; the time without the start-up is printed too. Both results must be identical.
 
@@ -19,8 +19,8 @@ import time
 
 import numpy as np
 
-from digslam.agents.evaluate import evaluate
-from digslam.agents.ray_eval import build_policy, evaluate_ray, start_ray
+from digslam.agents.evaluation.evaluate import evaluate
+from digslam.agents.evaluation.ray_eval import build_policy, evaluate_ray, start_ray
 
 ENV = "digslam/DigCoverage-v0"
 
@@ -54,22 +54,27 @@ def main() -> None:
                    steps=args.steps, env_kwargs=kw)  # fmt: skip
     t_seq = time.perf_counter() - t0
     steps = int(seq.lengths["frontier"].sum())
-    print(f"sequential: {args.episodes} episodes, {steps} steps in {t_seq:.1f} s ({1e3 * t_seq / steps:.2f} ms/step)")
+    print(
+        f"sequential: {args.episodes} episodes, {steps} steps in {t_seq:.1f} s ({1e3 * t_seq / steps:.2f} ms/step)"
+    )
 
     t0 = time.perf_counter()
     start_ray(None, args.workers)  # evaluate_ray attaches to it; timed separately
     t_init = time.perf_counter() - t0
     try:
-        dist = evaluate_ray(["frontier"], ENV, n_maps=args.episodes, seed=args.seed, steps=args.steps,
-                            env_kwargs=kw)
+        dist = evaluate_ray(
+            ["frontier"], ENV, n_maps=args.episodes, seed=args.seed, steps=args.steps, env_kwargs=kw
+        )
         t_run = time.perf_counter() - t0 - t_init
     finally:
         t1 = time.perf_counter()
         ray.shutdown()
         t_down = time.perf_counter() - t1
     t_ray = time.perf_counter() - t0
-    print(f"ray ({args.workers} workers): start {t_init:.1f} s, episodes {t_run:.1f} s, shutdown {t_down:.1f} s, "
-          f"total {t_ray:.1f} s")
+    print(
+        f"ray ({args.workers} workers): start {t_init:.1f} s, episodes {t_run:.1f} s, shutdown {t_down:.1f} s, "
+        f"total {t_ray:.1f} s"
+    )
     print(f"identical results: {same(seq, dist)}")
     print(f"mean certified coverage after {args.steps} steps: {seq.curves['frontier'][:, -1].mean():.3f}")
     print(f"speedup without the start-up and shutdown: {t_seq / t_run:.2f}")

@@ -1,6 +1,6 @@
 """ThickSivia benchmark: test-case 1 of thesis §A.5 (thick translation of a thick disk) at ε = 0.01, 0.001.
 
-Ours: :func:`digslam.observer.thick_sivia.thick_sivia` with the closed-form thick disk
+Ours: :func:`digslam.observer.thick.sivia.thick_sivia` with the closed-form thick disk
 (:meth:`ThickFunction.sqdist`), frame ``[−2, 4]²``. codac 1.5.6 (``ThickPaving`` with ``ThickDisk``)
 cannot be installed here, so its figures are the reference ones measured on this machine:
 0.034 s / 9,543 bisections at ε = 0.01 and 0.279 s / 76,521 bisections at ε = 0.001. The times are
@@ -14,8 +14,8 @@ import argparse
 import statistics
 import time
 
-from digslam.observer.thick_function import ThickFunction
-from digslam.observer.thick_sivia import thick_sivia
+from digslam.observer.thick.function import ThickFunction
+from digslam.observer.thick.sivia import thick_sivia
 
 FRAME = ([-2.0, -2.0], [4.0, 4.0])
 #: codac 1.5.6 reference on this machine: eps -> (seconds, bisections)

@@ -13,16 +13,36 @@ from __future__ import annotations
 
 import gymnasium as gym
 
-from digslam.agents import origin as _origin  # a shadowing source folder is reported in one line
-
-from .config import ExploreConfig, NoiseConfig
-from .episode import Episode, GroundTruth, record_episode, replay
-from .explore_env import ExploreEnv
-from .generators import Caves, FileMap, RockField, RoomsCorridors, ThesisRoom, WorldGenerator
-from .sensors import SensorSuite
-from .world import World
+from digslam.envs.config import ExploreConfig, NoiseConfig
+from digslam.envs.explore.env import ExploreEnv
+from digslam.envs.explore.episode import Episode, GroundTruth, record_episode, replay
+from digslam.envs.sim.sensors import SensorSuite
+from digslam.envs.world.generators import (
+    Caves,
+    FileMap,
+    RockField,
+    RoomsCorridors,
+    ThesisRoom,
+    WorldGenerator,
+)
+from digslam.envs.world.world import World
+from digslam.observer.core import compat as _compat
+from digslam.observer.core import origin as _origin  # a shadowing source folder is reported in one line
 
 _origin.warn_if_shadowed(__name__)
+
+#: Modules that moved into the concept folders: old name -> new path (the old path warns, for one release).
+MOVED = {
+    "geometry": "world.geometry", "geometry_jit": "world.geometry_jit", "raster": "world.raster",
+    "tracing": "world.tracing", "generators": "world.generators", "render": "world.render",
+    "arc": "sim.arc_jit", "robot": "sim.robot", "robot_jit": "sim.robot_jit", "sensors": "sim.sensors",
+    "noise": "sim.noise", "noise_jit": "sim.noise_jit", "coverage": "sim.coverage",
+    "coverage_jit": "sim.coverage_jit", "missions": "sim.missions", "explore_env": "explore.env",
+    "episode": "explore.episode", "observer_config": "dig_coverage.config",
+    "observer_wrapper": "dig_coverage.wrapper", "observer_maps": "dig_coverage.maps_jit",
+    "monitor": "dig_coverage.monitor",
+}  # fmt: skip
+_compat.install_aliases(__name__, MOVED)
 
 MAX_EPISODE_STEPS = 1000
 
@@ -43,26 +63,30 @@ COVERAGE_IDS: dict[str, dict[str, object]] = {
     "digslam/DigCoverageSonar-v0": {"omni": False},
     "digslam/DigCoverageCaves-v0": {"world": "caves", "world_size": 20.0},
     "digslam/DigCoverageAdversarial-v0": {"noise": {"model": "adversarial"}},
-    "digslam/DigCoverageOutliers-v0": {"world": "rocks", "noise": {"outlier_prob": 0.05, "max_outliers": 1},
-                                       "q": 1},  # fmt: skip
+    "digslam/DigCoverageOutliers-v0": {
+        "world": "rocks",
+        "noise": {"outlier_prob": 0.05, "max_outliers": 1},
+        "q": 1,
+    },  # fmt: skip
 }
 
 for _ids, _entry in (
-    (ENV_IDS, "digslam.envs.explore_env:ExploreEnv"),
-    (COVERAGE_IDS, "digslam.envs.dig_coverage:DigCoverageEnv"),
+    (ENV_IDS, "digslam.envs.explore.env:ExploreEnv"),
+    (COVERAGE_IDS, "digslam.envs.dig_coverage.env:DigCoverageEnv"),
 ):
     for _id, _kw in _ids.items():
         if _id not in gym.registry:
             gym.register(id=_id, entry_point=_entry, kwargs=dict(_kw), max_episode_steps=MAX_EPISODE_STEPS)
 
-#: Names of the observer side, imported on first use (they need ``digslam.observer.online`` and scipy).
+#: Names of the observer side, imported on first use (they need ``digslam.observer.online.observer`` and
+#: scipy).
 _LAZY = {
-    "DigCoverageEnv": "dig_coverage",
-    "DigCoverageConfig": "observer_config",
-    "ObserverConfig": "observer_config",
-    "GuaranteedObserver": "observer_wrapper",
-    "GuaranteeMonitor": "monitor",
-    "GuaranteeViolation": "monitor",
+    "DigCoverageEnv": "dig_coverage.env",
+    "DigCoverageConfig": "dig_coverage.config",
+    "ObserverConfig": "dig_coverage.config",
+    "GuaranteedObserver": "dig_coverage.wrapper",
+    "GuaranteeMonitor": "dig_coverage.monitor",
+    "GuaranteeViolation": "dig_coverage.monitor",
 }
 
 

@@ -84,7 +84,7 @@ class NoiseConfig(_Config):
         outlier_prob: Probability that a range reading is an outlier (flagged in the record).
         max_outliers: At most this many outliers per step (an integer >= 0; None: no cap). With
             ``max_outliers = q`` the premise of the observer's q-relaxed mode (``q`` outliers per step at
-            most, :class:`~digslam.observer.online.OnlineConfig`) holds exactly.
+            most, :class:`~digslam.observer.online.observer.OnlineConfig`) holds exactly.
     """
 
     speed: float = 0.001
@@ -206,3 +206,12 @@ class ExploreConfig(_Config):
                 "start",
                 f"must be a finite (x, y, theta), got {self.start!r}",
             )
+
+
+__all__ = [
+    "ExploreConfig",
+    "NOISE_MODELS",
+    "NoiseConfig",
+    "WORLDS",
+    "config_dataclass",
+]

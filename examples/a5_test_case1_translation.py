@@ -54,10 +54,10 @@ from pathlib import Path
 
 import numpy as np
 
-from digslam.observer.thick_function import ThickFunction
-from digslam.observer.thick_paver import ThickPaving, thick_pave
-from digslam.observer.thick_sep import CLEAR, DARK, PENUMBRA
-from digslam.observer.thick_sivia import thick_sivia
+from digslam.observer.thick.function import ThickFunction
+from digslam.observer.thick.paver import ThickPaving, thick_pave
+from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.sivia import thick_sivia
 
 V_LO, V_HI = [0.7, -0.02], [1.3, 0.02]
 R_MINUS, R_PLUS = 1.0, 2.0
@@ -207,7 +207,7 @@ def run(eps: float = 0.1, out: str | Path | None = None, classical_min_eps: floa
            "dark_area": p.dark_area, "boundary_area": p.boundary_area, "bisections": p.bisections,
            "classical_bisections": pc.bisections, "classical_boundary_area": pc.boundary_area}  # fmt: skip
     if out is not None:
-        from digslam.observer.draw import new_figure, save_figure
+        from digslam.observer.paving.draw import new_figure, save_figure
 
         fig, axes = new_figure(2, 1, size=4.5)
         pc.draw(axes[0], FRAME, f"classical intervals (ε = {eps})")

@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from digslam.observer.thick_function import ThickFunction
-from digslam.observer.thick_sivia import thick_sivia
+from digslam.observer.thick.function import ThickFunction
+from digslam.observer.thick.sivia import thick_sivia
 
 A_LO = np.array([[2.0, -2.0], [-1.0, 2.0]])
 A_HI = np.array([[4.0, 0.0], [1.0, 4.0]])
@@ -91,7 +91,7 @@ def run(eps: float = 0.01, out: str | Path | None = None) -> dict:
            "tolerable_area": ex["tolerable"], "united_area": ex["united"],
            "united_bbox": ex["united_bbox"]}  # fmt: skip
     if out is not None:
-        from digslam.observer.draw import draw_polygon, new_figure, save_figure
+        from digslam.observer.paving.draw import draw_polygon, new_figure, save_figure
 
         fig, ax = new_figure(1, 1, size=5.0)
         p.draw(ax, FRAME, f"Eq. A.40: tolerable ⊂ united solution set, ε = {eps}")

@@ -19,10 +19,11 @@ from pathlib import Path
 
 import numpy as np
 
-from digslam.observer import Function, arith, exp
-from digslam.observer.thick_function import ThickFunction
-from digslam.observer.thick_interval import ThickIntervalArray
-from digslam.observer.thick_sivia import thick_sivia
+from digslam.observer import Function, exp
+from digslam.observer.core import arith
+from digslam.observer.thick.function import ThickFunction
+from digslam.observer.thick.interval import ThickIntervalArray
+from digslam.observer.thick.sivia import thick_sivia
 
 T = np.array([[0.03, 0.06], [0.09, 0.12], [0.15, 0.18], [0.21, 0.24], [0.27, 0.30]])  # Table A.2
 Y = np.array([[4.0, 8.0], [2.0, 6.0], [2.0, 5.0], [1.0, 3.0], [0.0, 2.0]])
@@ -56,7 +57,7 @@ def run(eps: float = 0.1, out: str | Path | None = None) -> dict:
            "penumbra_area": p.penumbra_area, "dark_area": p.dark_area, "boundary_area": p.boundary_area,
            "classical_boundary_area": pc.boundary_area, "thesis": THESIS}  # fmt: skip
     if out is not None:
-        from digslam.observer.draw import new_figure, save_figure
+        from digslam.observer.paving.draw import new_figure, save_figure
 
         fig, axes = new_figure(2, 1, size=4.5)
         pc.draw(axes[0], FRAME, f"classical: {pc.n_boxes} boxes")

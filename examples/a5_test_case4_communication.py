@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from digslam.observer.thick_function import ThickFunction
-from digslam.observer.thick_sivia import thick_sivia
+from digslam.observer.thick.function import ThickFunction
+from digslam.observer.thick.sivia import thick_sivia
 
 MARKS = np.array([[1.0, 3.0], [10.0, -1.0], [10.0, 6.0], [-2.0, -5.0]])  # Table A.3
 M_LO, M_HI = MARKS - 0.5, MARKS + 0.5
@@ -61,7 +61,7 @@ def run(eps: float = 0.1, out: str | Path | None = None, grid: int = 1200) -> di
            "boundary_area": p.boundary_area, "classical_bisections": pc.bisections,
            "grid_lower_area": ga["lower"], "grid_upper_area": ga["upper"]}  # fmt: skip
     if out is not None:
-        from digslam.observer.draw import draw_boxes, new_figure, save_figure
+        from digslam.observer.paving.draw import draw_boxes, new_figure, save_figure
 
         fig, ax = new_figure(1, 1, size=5.0)
         p.draw(ax, FRAME, f"communication area, ε = {eps}")

@@ -5,10 +5,10 @@ Test-case 1 (thick translation of the thick disk ``[D(0, 1), D(0, 2)]`` by ``[v]
 
 * left: classical Sivia (Algorithm A.1), which never proves the penumbra;
 * centre: ThickSivia on the subset–supset representation (Eqs. A.13–A.15,
-  :func:`~digslam.observer.thick_subset.thick_sivia_subset_supset`): while a box is wider than
+  :func:`~digslam.observer.thick.subset.thick_sivia_subset_supset`): while a box is wider than
   ``[v]`` (0.04 across ``x₂``) the subset bound of ``⟦f⟧([x])`` is empty and the penumbra cannot be
   proved, so undetermined boxes remain inside it;
-* right: ThickSivia on lower–upper bounds (Algorithm A.2, :func:`~digslam.observer.thick_sivia.thick_sivia`).
+* right: ThickSivia on lower–upper bounds (Algorithm A.2, :func:`~digslam.observer.thick.sivia.thick_sivia`).
 
 The thesis times the three figures at 2.1 s, 0.21 s and 0.19 s (drawing included, i5-2520M).
 
@@ -30,10 +30,10 @@ from pathlib import Path
 
 import numpy as np
 
-from digslam.observer.thick_function import ThickFunction
-from digslam.observer.thick_sep import CLEAR, DARK, PENUMBRA
-from digslam.observer.thick_sivia import ThickInverse, thick_sivia
-from digslam.observer.thick_subset import thick_sivia_subset_supset
+from digslam.observer.thick.function import ThickFunction
+from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.sivia import ThickInverse, thick_sivia
+from digslam.observer.thick.subset import thick_sivia_subset_supset
 
 V_LO, V_HI = [0.7, -0.02], [1.3, 0.02]
 FRAME = ([-2.0, -2.0], [4.0, 4.0])
@@ -76,7 +76,7 @@ def run(eps: float = 0.1, out: str | Path | None = None) -> dict:
 
 
 def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.draw import new_figure, save_figure
+    from digslam.observer.paving.draw import new_figure, save_figure
 
     fig, axes = new_figure(ncols=3, size=4.5)
     for ax, kind in zip(axes, ("classical", "subset_supset", "lower_upper"), strict=True):

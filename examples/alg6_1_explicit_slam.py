@@ -12,7 +12,8 @@ heading is known from the compass and gyro, as in §6.3.2):
 * one-sided shapes (§6.2.3.2) every 0.1 s: each sonar cone's free sector ``Z⁻`` and its impact arc
   ``ΔZ`` (Eq. 6.17, 6.22).
 
-:func:`~digslam.observer.explicit_slam.explicit_slam` carves the thick map ``[M] = [∅, R²]`` and contracts
+:func:`~digslam.observer.slam.explicit_slam.explicit_slam` carves the thick map ``[M] = [∅, R²]`` and
+contracts
 the tube until nothing contracts. The figure shows the tube against dead reckoning, the map's clear
 (``M⁻``), penumbra and dark (``comp M⁺``) parts over the true rocks, and the tube width over time.
 
@@ -29,12 +30,12 @@ from pathlib import Path
 import numpy as np
 
 from digslam.envs.config import NoiseConfig
-from digslam.envs.generators import RockField
-from digslam.envs.missions import loop_mission
-from digslam.envs.raster import FREE, OCCUPIED
-from digslam.envs.sensors import SensorSuite
-from digslam.envs.world import World
-from digslam.observer.explicit_slam import (
+from digslam.envs.sim.missions import loop_mission
+from digslam.envs.sim.sensors import SensorSuite
+from digslam.envs.world.generators import RockField
+from digslam.envs.world.raster import FREE, OCCUPIED
+from digslam.envs.world.world import World
+from digslam.observer.slam.explicit_slam import (
     ExplicitSlamConfig,
     ExplicitSlamResult,
     RangeMeasurements,
@@ -43,8 +44,8 @@ from digslam.observer.explicit_slam import (
     explicit_slam,
     mission_tube,
 )
-from digslam.observer.grid import Grid
-from digslam.observer.thick_sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.slam.grid import Grid
+from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
 
 CELL = 0.25  # pixel side of the shapes and cell side of the map (a dyadic number: exact lattice)
 LOOP = np.array([(0.0, 0.0), (4.0, -4.5), (7.0, 0.0), (4.0, 5.0), (-1.0, 6.5), (-6.0, 4.0), (-7.0, -2.0),
@@ -146,7 +147,7 @@ def draw(res: ExplicitSlamResult, world: World, truth: np.ndarray, grid: Grid, o
     import matplotlib.pyplot as plt
     from matplotlib.collections import PolyCollection
 
-    from digslam.observer.draw import draw_grid
+    from digslam.observer.paving.draw import draw_grid
 
     out.mkdir(parents=True, exist_ok=True)
     fig, (a, b, c) = plt.subplots(1, 3, figsize=(19, 6.2))

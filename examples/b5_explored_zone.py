@@ -4,9 +4,9 @@ A robot runs a lawnmower survey in dead reckoning: its position is known only in
 with the distance run (the tube). Three pictures:
 
 * (B.8) patch exploration: a disk of radius in ``[r_lo, r_hi]`` seen at each of ``m`` times
-  (:func:`~digslam.observer.explored.explored_disks_grid`);
+  (:func:`~digslam.observer.slam.explored.explored_disks_grid`);
 * (B.7) sweep exploration: a side-scan segment perpendicular to the path, sensed continuously
-  (:func:`~digslam.observer.explored_sweep.explored_sweep_grid`, Theorem B.1 over runs of gates);
+  (:func:`~digslam.observer.slam.explored_sweep.explored_sweep_grid`, Theorem B.1 over runs of gates);
 * (B.2) two candidate trajectories whose opposite sonar pies cross: the cross intersection is clear
   once the hypotheses are joined (Eq. B.7), and not with the hull tube.
 
@@ -24,10 +24,10 @@ from pathlib import Path
 
 import numpy as np
 
-from digslam.observer.explored import explored_disks_grid, explored_hypotheses
-from digslam.observer.explored_sweep import explored_sectors_grid, explored_sweep_grid, sweep_gates
-from digslam.observer.grid import Grid
-from digslam.observer.thick_sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.slam.explored import explored_disks_grid, explored_hypotheses
+from digslam.observer.slam.explored_sweep import explored_sectors_grid, explored_sweep_grid, sweep_gates
+from digslam.observer.slam.grid import Grid
+from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
 
 FRAME = ((-12.0, -12.0), (12.0, 12.0))
 
@@ -73,8 +73,15 @@ def fig_b2() -> dict:
     lo, hi = np.minimum(pos["a"], pos["b"]), np.maximum(pos["a"], pos["b"])
     hull = explored_sectors_grid(g, lo, hi, np.minimum(psi["a"], psi["b"]), np.maximum(psi["a"], psi["b"]),
                                  0.0, gam, r, r)  # fmt: skip
-    return {"grid": g, "a": st["a"], "b": st["b"], "joined": joined, "hull": hull,
-            "cross_clear_cells": int((joined == CLEAR).sum()), "hull_clear_cells": int((hull == CLEAR).sum())}
+    return {
+        "grid": g,
+        "a": st["a"],
+        "b": st["b"],
+        "joined": joined,
+        "hull": hull,
+        "cross_clear_cells": int((joined == CLEAR).sum()),
+        "hull_clear_cells": int((hull == CLEAR).sum()),
+    }
 
 
 def run(m: int = 12000, out: str | Path | None = None, sweep_m: int = 1500, cells: int = 480) -> dict:
@@ -104,7 +111,7 @@ def run(m: int = 12000, out: str | Path | None = None, sweep_m: int = 1500, cell
            "b2_cross_clear_cells": b2["cross_clear_cells"], "b2_hull_clear_cells": b2["hull_clear_cells"],
            "final_tube_halfwidth": float(sv["e"][-1])}  # fmt: skip
     if out is not None:
-        from digslam.observer.draw import draw_grid, new_figure, save_figure
+        from digslam.observer.paving.draw import draw_grid, new_figure, save_figure
 
         fig, axes = new_figure(2, 1, size=6.0)
         panels = ((axes[0], disks, g, sv, "patch (disks), cf. Fig. B.8"),

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from digslam.observer import Box, CtcFwdBwd, Function, Interval, Sep, SepInter, cos, pave, sin
-from digslam.observer.polar_sep import SepLandmark
+from digslam.observer.polar.sep import SepLandmark
 
 FRAME = Box([(-4, 6), (-4, 6)])
 TRUE_POSITION = (1.0, 1.0)
@@ -163,7 +163,7 @@ def run(eps: float = 0.05, out: str | Path | None = None) -> dict:
 
 
 def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.draw import draw_paving, new_figure, save_figure
+    from digslam.observer.paving.draw import draw_paving, new_figure, save_figure
 
     fig, axes = new_figure(ncols=3, size=4.5)
     ax = axes[0]

@@ -87,7 +87,7 @@ def run(eps: float = 0.05, out: str | Path | None = None, exact_n: int = 2000) -
 def draw(p, path: Path) -> Path:
     from matplotlib.patches import Circle
 
-    from digslam.observer.draw import draw_paving, new_figure, save_figure
+    from digslam.observer.paving.draw import draw_paving, new_figure, save_figure
 
     fig, ax = new_figure(size=7)
     draw_paving(p, ax, frame=FRAME, linewidth=0.1)

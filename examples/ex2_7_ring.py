@@ -69,7 +69,7 @@ def run(eps: float = 0.05, out: str | Path | None = None) -> dict:
 
 
 def draw(pc, ps, path: Path) -> Path:
-    from digslam.observer.draw import draw_paving, new_figure, save_figure
+    from digslam.observer.paving.draw import draw_paving, new_figure, save_figure
 
     fig, (a, b) = new_figure(ncols=2, size=5)
     draw_paving(

@@ -118,7 +118,7 @@ def run(eps: float = 0.02, out: str | Path | None = None) -> dict:
 
 
 def draw(pavings, path: Path) -> Path:
-    from digslam.observer.draw import draw_paving, draw_polygon, new_figure, save_figure
+    from digslam.observer.paving.draw import draw_paving, draw_polygon, new_figure, save_figure
 
     fig, axes = new_figure(ncols=3, size=4.5)
     titles = ("(a) M", "(b) R_π/4(M)", "(c) R_π/4(M) ∩ ~M")

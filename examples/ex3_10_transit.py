@@ -24,10 +24,10 @@ from pathlib import Path
 
 import numpy as np
 
-from digslam.observer import arith as A
-from digslam.observer import trig as T
-from digslam.observer.boxes import width_euclid
-from digslam.observer.polar_sep import SepLandmark, sep_landmark_fwdbwd
+from digslam.observer.core import arith as A
+from digslam.observer.core import trig as T
+from digslam.observer.core.boxes import width_euclid
+from digslam.observer.polar.sep import SepLandmark, sep_landmark_fwdbwd
 
 SHIP = (0.0, 0.0)
 DT, DURATION, FIX_PERIOD = 0.5, 100.0, 1.0
@@ -124,7 +124,7 @@ def run(
 
 
 def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.draw import new_figure, save_figure
+    from digslam.observer.paving.draw import new_figure, save_figure
 
     fig, (a, b) = new_figure(ncols=2, size=5)
     x = res["data"]["x"]

@@ -9,7 +9,7 @@ two half-turns, 180 s), a forward-looking sonar (range 10–70 m, aperture ±30�
 every error sits exactly on its bound (random sign). Each data interval is widened by ``1e-9`` (times
 the magnitude of the value) to absorb the simulator's own float error, nothing more.
 
-:func:`~digslam.observer.landmarks.localize` iterates Eq. 3.70 to the fixpoint and prints Table 3.3:
+:func:`~digslam.observer.slam.landmarks.localize` iterates Eq. 3.70 to the fixpoint and prints Table 3.3:
 per iteration, the min / max number of landmarks in the ``[m_i]`` and the number of unique
 associations. The figure shows the scenario (Fig. 3.12), the final tube and the widths of the
 position gates along the mission for several iterations (Fig. 3.13).
@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from digslam.observer.landmarks import Localization, localize
+from digslam.observer.slam.landmarks import Localization, localize
 
 N_LANDMARKS, MAP_LO, MAP_HI = 280, (-150.0, -80.0), (60.0, 50.0)
 DT, SUB, DURATION, PING = 1.0, 10, 180, 3
@@ -105,8 +105,14 @@ def solve(data: dict, max_iter: int = 50, disjunctive: bool = True) -> Localizat
                     data["landmarks"], max_iter=max_iter, disjunctive=disjunctive)  # fmt: skip
 
 
-def run(eps: float = 0.0, out: str | Path | None = None, seed: int = SEED, noise: str = "uniform",
-        max_iter: int = 50, disjunctive: bool = True) -> dict:
+def run(
+    eps: float = 0.0,
+    out: str | Path | None = None,
+    seed: int = SEED,
+    noise: str = "uniform",
+    max_iter: int = 50,
+    disjunctive: bool = True,
+) -> dict:
     """Simulate, localize, check against the truth; ``eps`` is unused (no paving)."""
     data = simulate(seed, noise)
     t0 = time.perf_counter()
@@ -130,7 +136,7 @@ def run(eps: float = 0.0, out: str | Path | None = None, seed: int = SEED, noise
 def draw(r: dict, path: Path) -> Path:
     from matplotlib.patches import Rectangle, Wedge
 
-    from digslam.observer.draw import new_figure, save_figure
+    from digslam.observer.paving.draw import new_figure, save_figure
 
     d, res = r["data"], r["result"]
     fig, (a, b) = new_figure(ncols=2, size=6)

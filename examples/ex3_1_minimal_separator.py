@@ -69,7 +69,7 @@ def run(eps: float = EPS, out: str | Path | None = None, frame: Box = FRAME) -> 
 
 
 def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.draw import draw_paving, new_figure, save_figure
+    from digslam.observer.paving.draw import draw_paving, new_figure, save_figure
 
     fig, axes = new_figure(ncols=2, size=5)
     view = Box([(-4.5, 5), (-8, 8)])  # both first outer boxes

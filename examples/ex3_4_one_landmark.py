@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from digslam.observer import Box, pave
-from digslam.observer.polar_sep import SepLandmark, sep_landmark_fwdbwd
+from digslam.observer.polar.sep import SepLandmark, sep_landmark_fwdbwd
 
 LANDMARK = (0.0, 0.0)
 RANGE = (4.0, 6.0)
@@ -67,7 +67,7 @@ def run(eps: float = 0.01, out: str | Path | None = None, default_cut: bool = Tr
 
 
 def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.draw import draw_paving, new_figure, save_figure
+    from digslam.observer.paving.draw import draw_paving, new_figure, save_figure
 
     fig, axes = new_figure(ncols=2, size=5)
     for ax, (name, label) in zip(axes, (("polar", "minimal polar separator"), ("fwdbwd", "forward-backward")),
@@ -100,11 +100,15 @@ def main(argv: list[str] | None = None) -> dict:
             f"undetermined {v['boundary_area']:.4f}, {v['bisections']} bisections, {v['seconds']:.2f} s"
         )
     d = r["default_cut"]
-    print(f"  policy cut='grid', max_volume=eps²/2: polar {r['polar']['bisections']} < forward-backward "
-          f"{r['fwdbwd']['bisections']} bisections, as §3.4.1.1 claims")
-    print(f"  default midpoint cut: polar {d['polar']} vs forward-backward {d['fwdbwd']} bisections: "
-          "likely because the minimal separator's exact hulls are cut at their own middles, so the cuts of "
-          "neighbouring boxes do not line up and more slivers straddle the pie's arcs and rays")
+    print(
+        f"  policy cut='grid', max_volume=eps²/2: polar {r['polar']['bisections']} < forward-backward "
+        f"{r['fwdbwd']['bisections']} bisections, as §3.4.1.1 claims"
+    )
+    print(
+        f"  default midpoint cut: polar {d['polar']} vs forward-backward {d['fwdbwd']} bisections: "
+        "likely because the minimal separator's exact hulls are cut at their own middles, so the cuts of "
+        "neighbouring boxes do not line up and more slivers straddle the pie's arcs and rays"
+    )
     print(f"  wrote {r['png']}")
     return r
 

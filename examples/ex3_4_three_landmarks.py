@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from digslam.observer import Box, SepInter, pave
-from digslam.observer.polar_sep import SepLandmark, sep_landmark_fwdbwd
+from digslam.observer.polar.sep import SepLandmark, sep_landmark_fwdbwd
 
 #: Table 3.1: landmark position, range [m], bearing [deg]
 TABLE = [((6.0, 12.0), (11.0, 12.0), (14.0, 100.0)),
@@ -51,7 +51,7 @@ def run(eps: float = 0.05, out: str | Path | None = None) -> dict:
 
 
 def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.draw import draw_paving, new_figure, save_figure
+    from digslam.observer.paving.draw import draw_paving, new_figure, save_figure
 
     fig, ax = new_figure(size=6)
     p = res["pavings"]["polar"]

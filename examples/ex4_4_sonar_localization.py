@@ -28,10 +28,11 @@ from pathlib import Path
 import numpy as np
 
 from digslam.observer import Box, SepPolygon, pave
-from digslam.observer.boxes import empty_rows
-from digslam.observer.minkowski import SepMinkowskiDiff
-from digslam.observer.registration import sep_cone
-from digslam.observer.separators import Batch, Sep
+from digslam.observer.core.boxes import empty_rows
+from digslam.observer.core.types import Batch
+from digslam.observer.sets.minkowski import SepMinkowskiDiff
+from digslam.observer.sets.registration import sep_cone
+from digslam.observer.sets.separators import Sep
 
 #: the map M (free space): an irregular room, counter-clockwise
 MAP = np.array([(0, 0), (12, 0), (12, 3), (15, 3), (16, -1), (20, 0), (20, 9), (16, 12), (13, 10), (9, 14),
@@ -185,7 +186,7 @@ def run(eps: float = 0.1, out: str | Path | None = None, eps_proj: float | None 
 
 
 def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.draw import draw_paving, draw_polygon, new_figure, save_figure
+    from digslam.observer.paving.draw import draw_paving, draw_polygon, new_figure, save_figure
 
     fig, axes = new_figure(ncols=3, size=5.0)
     ax = axes[0]

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from digslam.observer import Box, Function, Interval, SepBox, SepInverse, SepPolygon, pave
-from digslam.observer.minkowski import SepMinkowskiDiff, SepMinkowskiSum
+from digslam.observer.sets.minkowski import SepMinkowskiDiff, SepMinkowskiSum
 
 RADIUS = 5.0
 RECT = np.array([(-2.0, -1.0), (2.0, -1.0), (2.0, 1.0), (-2.0, 1.0)])  # A of Ex. 4.1, 4 × 2
@@ -153,7 +153,7 @@ def run(eps: float = 0.05, out: str | Path | None = None, eps_proj: float | None
 
 
 def draw(res: dict, out: Path) -> list[Path]:
-    from digslam.observer.draw import draw_paving, draw_polygon, new_figure, save_figure
+    from digslam.observer.paving.draw import draw_paving, draw_polygon, new_figure, save_figure
 
     paths = []
     fig, ax = new_figure(size=5.5)

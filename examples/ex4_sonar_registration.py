@@ -21,8 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from digslam.observer import Box, Interval, IntervalArray, SepBox, pave, rounding, trig
-from digslam.observer.registration import scaling, sep_cone, sep_inclusion
+from digslam.observer import Box, Interval, IntervalArray, SepBox, pave
+from digslam.observer.core import rounding, trig
+from digslam.observer.sets.registration import scaling, sep_cone, sep_inclusion
 
 #: the thesis's enclosure (Eq. 4.26)
 PUBLISHED = (6.2988, 6.3085)
@@ -90,7 +91,7 @@ def run(eps: float = 1e-5, out: str | Path | None = None) -> dict:
 
 
 def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.draw import new_figure, save_figure
+    from digslam.observer.paving.draw import new_figure, save_figure
 
     fig, ax = new_figure(size=5.0)
     ax.fill([5, 12, 12, 5], [3, 3, 12, 12], hatch="//", facecolor="none", edgecolor="k", linewidth=0.5)

@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from digslam.observer import Box, cos, sin
-from digslam.observer.thick_inversion import thick_inverse_classical, thick_inverse_proj
-from digslam.observer.thick_paver import ThickPaving, thick_pave
+from digslam.observer.thick.inversion import thick_inverse_classical, thick_inverse_proj
+from digslam.observer.thick.paver import ThickPaving, thick_pave
 
 THETA = (np.pi / 6, np.pi / 3)
 Y = Box([(0, 3), (4, 5)])
@@ -53,7 +53,7 @@ def run(eps: float = 0.05, out: str | Path | None = None) -> dict:
            "sampled_lower_area": float(inside.all(0).sum() * cell),
            "sampled_upper_area": float(inside.any(0).sum() * cell)}  # fmt: skip
     if out is not None:
-        from digslam.observer.draw import (
+        from digslam.observer.paving.draw import (
             CLEAR_COLOR,
             DARK_COLOR,
             PENUMBRA_COLOR,

@@ -31,9 +31,10 @@ from typing import Any
 
 import numpy as np
 
-from digslam.observer import Function, Interval, SepImage, cos, sin, trig
-from digslam.observer.thick_carving import SRACResult, srac
-from digslam.observer.thick_sep import ThickSep
+from digslam.observer import Function, Interval, SepImage, cos, sin
+from digslam.observer.core import trig
+from digslam.observer.thick.carving import SRACResult, srac
+from digslam.observer.thick.sep import ThickSep
 
 P_STAR = (2.8, -1.0)
 P0 = [(0.0, 4.0), (-2.0, 2.0)]
@@ -153,7 +154,7 @@ def run(eps: float = 0.01, out: str | Path | None = None, draw_eps: float = 0.1,
 
 def draw(res: dict, path: Path, draw_eps: float) -> Path:
     """Figure 5.10: (a) ``[A]``, (b) ``[B]``, (c) carved ``[A]``, (d) carved ``[B]``; Fig. 5.11 inset box."""
-    from digslam.observer.draw import (
+    from digslam.observer.paving.draw import (
         BOUNDARY_COLOR,
         CLEAR_COLOR,
         DARK_COLOR,
@@ -162,7 +163,7 @@ def draw(res: dict, path: Path, draw_eps: float) -> Path:
         new_figure,
         save_figure,
     )
-    from digslam.observer.thick_paver import thick_pave
+    from digslam.observer.thick.paver import thick_pave
 
     v, r = res["views"], res["result"]
     fig, axes = new_figure(2, 2, size=4.5)
@@ -189,10 +190,14 @@ def main(argv: list[str] | None = None) -> dict:
     r = run(a.eps, a.out, a.draw_eps)
     (p1, p2), ((q1, q2)) = r["p"], r["published"]
     print(f"Ex. 5.5 SRAC at eps={a.eps:g}: {r['seconds']:.1f} s")
-    print(f"  [p] = [{p1[0]:.5f}, {p1[1]:.5f}] x [{p2[0]:.5f}, {p2[1]:.5f}] (widths {r['width'][0]:.5f}, "
-          f"{r['width'][1]:.5f}); contains p* = {P_STAR}: {r['contains_p_star']}")
-    print(f"  published [{q1[0]}, {q1[1]}] x [{q2[0]}, {q2[1]}] (widths {r['published_width'][0]:.5f}, "
-          f"{r['published_width'][1]:.5f}); no wider: {r['no_wider_than_published']}")
+    print(
+        f"  [p] = [{p1[0]:.5f}, {p1[1]:.5f}] x [{p2[0]:.5f}, {p2[1]:.5f}] (widths {r['width'][0]:.5f}, "
+        f"{r['width'][1]:.5f}); contains p* = {P_STAR}: {r['contains_p_star']}"
+    )
+    print(
+        f"  published [{q1[0]}, {q1[1]}] x [{q2[0]}, {q2[1]}] (widths {r['published_width'][0]:.5f}, "
+        f"{r['published_width'][1]:.5f}); no wider: {r['no_wider_than_published']}"
+    )
     print(f"  wrote {r.get('figure')}")
     return r
 

@@ -28,10 +28,10 @@ from typing import Any
 
 import numpy as np
 
-from digslam.observer.boxes import width_euclid
-from digslam.observer.shape_registration import ThickImage, level_thick_image, register_translation
-from digslam.observer.shape_slam import ShapeSlamConfig, ShapeSlamResult, ctc_minus, shape_slam
-from digslam.observer.tube import Tube, body_velocity, ctc_deriv
+from digslam.observer.core.boxes import width_euclid
+from digslam.observer.slam.shape_registration import ThickImage, level_thick_image, register_translation
+from digslam.observer.slam.shape_slam import ShapeSlamConfig, ShapeSlamResult, ctc_minus, shape_slam
+from digslam.observer.tube.tube import Tube, body_velocity, ctc_deriv
 
 DT, SPEED, V_ERR, PSI_ERR = 0.1, 2.0, 0.02, np.deg2rad(0.05)
 PERIOD, WINDOW = 25.0, 30.0
@@ -206,7 +206,7 @@ def draw(st: dict, path: Path) -> Path:
     """(a) truth, dead-reckoning and SLAM tube boxes every 20 s; (b) tube widths over time (Fig. 6.7–6.8)."""
     from matplotlib.patches import Rectangle
 
-    from digslam.observer.draw import new_figure, save_figure
+    from digslam.observer.paving.draw import new_figure, save_figure
 
     sim, res, dr = st["sim"], st["result"], st["dead_reckoning"]
     fig, (ax, bx) = new_figure(2, 1, size=6.0)

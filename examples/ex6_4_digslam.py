@@ -17,10 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from digslam.envs.generators import ThesisRoom
-from digslam.envs.missions import loop_mission
-from digslam.observer.digslam import DigSlamResult, dig_slam
-from digslam.observer.grid import Grid
+from digslam.envs.sim.missions import loop_mission
+from digslam.envs.world.generators import ThesisRoom
+from digslam.observer.slam.digslam import DigSlamResult, dig_slam
+from digslam.observer.slam.grid import Grid
 
 
 def run(duration: float = 1200.0, cell: float = 0.05, seed: int = 0, out: str | Path | None = None) -> dict:
@@ -57,7 +57,7 @@ def draw(res: DigSlamResult, world: object, truth: np.ndarray, grid: Grid, out: 
     from matplotlib.collections import PolyCollection
 
     out.mkdir(parents=True, exist_ok=True)
-    from digslam.observer.draw import draw_grid
+    from digslam.observer.paving.draw import draw_grid
 
     fig, (a, b, c) = plt.subplots(1, 3, figsize=(19, 6.2))
     rings = [np.vstack([r, r[:1]]) for r in world.rings]  # type: ignore[attr-defined]

@@ -178,7 +178,7 @@ def run(
 
 
 def draw(p, meas: dict, path: Path) -> Path:
-    from digslam.observer.draw import draw_boxes, draw_polygon, new_figure, save_figure
+    from digslam.observer.paving.draw import draw_boxes, draw_polygon, new_figure, save_figure
 
     fig, (a, b) = new_figure(ncols=2, size=6)
     for ax in (a, b):

@@ -206,7 +206,7 @@ def run(eps: float = 0.02, out: str | Path | None = None) -> dict:
 
 
 def draw(p, poly: np.ndarray, path: Path) -> Path:
-    from digslam.observer.draw import draw_paving, draw_polygon, new_figure, save_figure
+    from digslam.observer.paving.draw import draw_paving, draw_polygon, new_figure, save_figure
 
     fig, (a, b) = new_figure(ncols=2, size=6)
     draw_paving(p, a, frame=FRAME, linewidth=0.05, title="(a) configuration space M and a feasible path")

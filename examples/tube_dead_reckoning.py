@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from digslam.observer.tube import (
+from digslam.observer.tube.tube import (
     ctc_deriv,
     dead_reckoning,
     heading_from_compass,
@@ -93,11 +93,20 @@ def run(out: str | Path | None = None, minutes: float = 20.0, seed: int = 0) -> 
         "contracted_width_mean": float(y.widths().mean()),
         "seconds_build": t1 - t0,
         "seconds_ctc_deriv": t3 - t2,
-        "truth_inside": bool(x.contains(fine, pos).all() and y.contains(fine, pos).all()
-                             and psi.contains(fine, heading(fine)).all()),  # fmt: skip
+        "truth_inside": bool(
+            x.contains(fine, pos).all()
+            and y.contains(fine, pos).all()
+            and psi.contains(fine, heading(fine)).all()
+        ),  # fmt: skip
     }
     if out is not None:
-        from digslam.observer.draw import BOUNDARY_COLOR, INSIDE_COLOR, draw_boxes, new_figure, save_figure
+        from digslam.observer.paving.draw import (
+            BOUNDARY_COLOR,
+            INSIDE_COLOR,
+            draw_boxes,
+            new_figure,
+            save_figure,
+        )
 
         fig, (ax0, axz, ax1) = new_figure(3, 1, size=4.5)
         fx = pos[np.array(fix_idx) * 10]

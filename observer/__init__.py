@@ -7,11 +7,61 @@ Dig-SLAM observer (:func:`dig_slam`, :class:`DigMap` on a :class:`Grid`), all ac
 two float64 arrays ``lo, hi`` of shape ``(N, n)``.
 """
 
-from . import arith, boxes, rounding, trig
-from .contractors import Ctc, CtcCompose, CtcFixPoint, CtcFwdBwd, CtcInter, CtcUnion
-from .digmap import DigMap
-from .digslam import DigSlamConfig, DigSlamResult, dig_slam
-from .explicit_slam import (
+from digslam.observer.core import arith, boxes, compat, rounding, trig
+from digslam.observer.core.interval import Box, Interval, IntervalArray, dot
+from digslam.observer.expr.expr import Expr, Function
+from digslam.observer.expr.ops import (
+    abs_,
+    acos,
+    asin,
+    atan,
+    atan2,
+    cos,
+    exp,
+    log,
+    maximum,
+    minimum,
+    pown,
+    sin,
+    sqr,
+    sqrt,
+    tan,
+)
+from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam
+from digslam.observer.paving.paver import Paving, PavingTree, pave
+from digslam.observer.paving.regular import classify_grid
+from digslam.observer.paving.subpaving import SepSubpaving, load, save, simplify
+from digslam.observer.polar.ctc import CtcPolar
+from digslam.observer.polar.sep import (
+    SepCtcPreimage,
+    SepLandmark,
+    SepPi,
+    SepPiInv,
+    SepPolarXY,
+    complement_boxes,
+    sep_landmark_fwdbwd,
+)
+from digslam.observer.sets.contractors import Ctc, CtcCompose, CtcFixPoint, CtcFwdBwd, CtcInter, CtcUnion
+from digslam.observer.sets.minkowski import SepMinkowskiDiff, SepMinkowskiSum, sep_negate
+from digslam.observer.sets.projection import SepOnDims, SepProj
+from digslam.observer.sets.registration import (
+    SepRegistration,
+    rigid2d,
+    scaling,
+    sep_cone,
+    sep_inclusion,
+    sep_intersection,
+    transform_function,
+    translation,
+)
+from digslam.observer.sets.sep_image import CtcImage, SepImage
+from digslam.observer.sets.sep_inverse import SepInverse
+from digslam.observer.sets.sep_polygon import CtcPolygonBoundary, CtcSegments, SepPolygon
+from digslam.observer.sets.separators import Sep, SepBox, SepInter, SepNot, SepQInter, SepUnion
+from digslam.observer.sets.transforms import CtcTransform, SepTransform, Transform, symmetric_union
+from digslam.observer.slam.digmap import DigMap
+from digslam.observer.slam.digslam import DigSlamConfig, DigSlamResult, dig_slam
+from digslam.observer.slam.explicit_slam import (
     ExplicitSlamConfig,
     ExplicitSlamResult,
     MapFunction,
@@ -25,7 +75,7 @@ from .explicit_slam import (
     shape_carve,
     shape_register,
 )
-from .explored import (
+from digslam.observer.slam.explored import (
     SepExploredDisks,
     explored_disks_grid,
     explored_disks_thick_sep,
@@ -33,11 +83,9 @@ from .explored import (
     explored_thick_sep,
     explored_union,
 )
-from .explored_sweep import explored_sectors_grid, explored_sweep_grid, sweep_gates
-from .expr import Expr, Function
-from .grid import Grid
-from .interval import Box, Interval, IntervalArray, dot
-from .landmarks import (
+from digslam.observer.slam.explored_sweep import explored_sectors_grid, explored_sweep_grid, sweep_gates
+from digslam.observer.slam.grid import Grid
+from digslam.observer.slam.landmarks import (
     CtcLandmarks,
     IterationStats,
     Localization,
@@ -45,41 +93,21 @@ from .landmarks import (
     contract_disjunctive,
     localize,
 )
-from .minkowski import SepMinkowskiDiff, SepMinkowskiSum, sep_negate
-from .online import OnlineConfig, OnlineDigSlam
-from .ops import abs_, acos, asin, atan, atan2, cos, exp, log, maximum, minimum, pown, sin, sqr, sqrt, tan
-from .paver import Paving, PavingTree, pave
-from .polar_ctc import CtcPolar
-from .polar_sep import (
-    SepCtcPreimage,
-    SepLandmark,
-    SepPi,
-    SepPiInv,
-    SepPolarXY,
-    complement_boxes,
-    sep_landmark_fwdbwd,
+from digslam.observer.slam.shape_registration import (
+    SepTranslationInclusion,
+    ThickImage,
+    level_thick_image,
+    register_translation,
 )
-from .projection import SepOnDims, SepProj
-from .registration import (
-    SepRegistration,
-    rigid2d,
-    scaling,
-    sep_cone,
-    sep_inclusion,
-    sep_intersection,
-    transform_function,
-    translation,
+from digslam.observer.slam.shape_slam import (
+    ShapeSlamConfig,
+    ShapeSlamResult,
+    ctc_minus,
+    overlap_pretest,
+    shape_slam,
 )
-from .regular import classify_grid
-from .sep_image import CtcImage, SepImage
-from .sep_inverse import SepInverse
-from .sep_polygon import CtcPolygonBoundary, CtcSegments, SepPolygon
-from .separators import Sep, SepBox, SepInter, SepNot, SepQInter, SepUnion
-from .shape_registration import SepTranslationInclusion, ThickImage, level_thick_image, register_translation
-from .shape_slam import ShapeSlamConfig, ShapeSlamResult, ctc_minus, overlap_pretest, shape_slam
-from .shapes import free_zone, impact_zone, measurement_shapes
-from .subpaving import SepSubpaving, load, save, simplify
-from .thick_carving import (
+from digslam.observer.slam.shapes import free_zone, impact_zone, measurement_shapes
+from digslam.observer.thick.carving import (
     SRACResult,
     ctc_image_equal,
     ctc_image_param,
@@ -89,12 +117,12 @@ from .thick_carving import (
     param_hull,
     srac,
 )
-from .thick_function import ThickFunction
-from .thick_interval import ThickIntervalArray, thin
-from .thick_inversion import SepFixedParam, thick_inverse_classical, thick_inverse_proj
-from .thick_ops import thick_image, thick_image_param, thick_minkowski_sum, thick_product
-from .thick_paver import ThickPaving, ThickTest, thick_pave
-from .thick_sep import (
+from digslam.observer.thick.function import ThickFunction
+from digslam.observer.thick.interval import ThickIntervalArray, thin
+from digslam.observer.thick.inversion import SepFixedParam, thick_inverse_classical, thick_inverse_proj
+from digslam.observer.thick.ops import thick_image, thick_image_param, thick_minkowski_sum, thick_product
+from digslam.observer.thick.paver import ThickPaving, ThickTest, thick_pave
+from digslam.observer.thick.sep import (
     CLEAR,
     DARK,
     PENUMBRA,
@@ -103,11 +131,14 @@ from .thick_sep import (
     thick_classify_grid,
     thick_relaxed_intersection,
 )
-from .thick_set import ctc_equal, ctc_subset
-from .thick_sivia import ThickInverse, thick_sivia
-from .thick_subset import SubsetSupsetArray, ThickInverseSubsetSupset, thick_sivia_subset_supset
-from .transforms import CtcTransform, SepTransform, Transform, symmetric_union
-from .tube import (
+from digslam.observer.thick.set import ctc_equal, ctc_subset
+from digslam.observer.thick.sivia import ThickInverse, thick_sivia
+from digslam.observer.thick.subset import (
+    SubsetSupsetArray,
+    ThickInverseSubsetSupset,
+    thick_sivia_subset_supset,
+)
+from digslam.observer.tube.tube import (
     Tube,
     body_velocity,
     ctc_deriv,
@@ -116,6 +147,8 @@ from .tube import (
     heading_from_gyro,
     unicycle_velocity,
 )
+
+compat.install_aliases(__name__, compat.OBSERVER)  # the flat module paths of 0.1, for one release
 
 __all__ = [
     "arith", "boxes", "rounding", "trig",

@@ -229,7 +229,9 @@ class Auditor:
                     if gamma[s] >= math.pi:
                         return True
                     phi = mpmath.mpf(ex.th) + mpmath.mpf(float(alpha[s]))
-                    if mpmath.cos(phi) * vx + mpmath.sin(phi) * vy >= r * mpmath.cos(mpmath.mpf(float(gamma[s]))):
+                    if mpmath.cos(phi) * vx + mpmath.sin(phi) * vy >= r * mpmath.cos(
+                        mpmath.mpf(float(gamma[s]))
+                    ):
                         return True
         return False
 
@@ -261,7 +263,9 @@ class Auditor:
         if self.prev_dark is not None:
             again = dark & ~self.prev_dark
             if again.any():
-                self.log.append(f"step {self.k}: {int(again.sum())} cells turned dark again; checked against all steps")
+                self.log.append(
+                    f"step {self.k}: {int(again.sum())} cells turned dark again; checked against all steps"
+                )
                 for j in range(len(self.premise.poses) - 1):
                     self._dark_step(again, j)
         self.prev_dark = dark.copy()
@@ -273,7 +277,10 @@ class Auditor:
         reach = float(rho.max())
         if not reach > 0:
             return
-        x0, x1 = np.searchsorted(self.xs, p[0] - reach - 1) - 1, np.searchsorted(self.xs, p[0] + reach + 1) + 1
+        x0, x1 = (
+            np.searchsorted(self.xs, p[0] - reach - 1) - 1,
+            np.searchsorted(self.xs, p[0] + reach + 1) + 1,
+        )
         r0 = np.searchsorted(-self.ys, -(p[1] + reach + 1)) - 1
         r1 = np.searchsorted(-self.ys, -(p[1] - reach - 1)) + 1
         ny, nx = self.shape
@@ -318,7 +325,9 @@ def _box_cone_min_float(p: np.ndarray, lo: np.ndarray, hi: np.ndarray, phi: np.n
     corners = np.stack([lo, np.c_[hi[:, 0], lo[:, 1]], hi, np.c_[lo[:, 0], hi[:, 1]]], axis=1)
     fx = np.clip(p[0], lo[:, 0], hi[:, 0])
     fy = np.clip(p[1], lo[:, 1], hi[:, 1])
-    feet = np.stack([np.c_[fx, lo[:, 1]], np.c_[fx, hi[:, 1]], np.c_[lo[:, 0], fy], np.c_[hi[:, 0], fy]], axis=1)
+    feet = np.stack(
+        [np.c_[fx, lo[:, 1]], np.c_[fx, hi[:, 1]], np.c_[lo[:, 0], fy], np.c_[hi[:, 0], fy]], axis=1
+    )
     cand = np.concatenate([cl[:, None], corners, feet], axis=1) - p  # (N, 9, 2)
     r = np.hypot(cand[..., 0], cand[..., 1])
     ang = np.arctan2(cand[..., 1], cand[..., 0])

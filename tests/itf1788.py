@@ -230,7 +230,7 @@ class Op(NamedTuple):
 
 def kernels() -> dict[str, Op]:
     """ITL operation name -> kernel of :mod:`digslam.observer` (imported here, not at module load)."""
-    from digslam.observer import arith, trig
+    from digslam.observer.core import arith, trig
 
     def recip(a):
         one = np.ones_like(a[0])

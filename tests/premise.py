@@ -280,7 +280,9 @@ class PremiseChecker:
         r_max = np.asarray(record.r_max, dtype=np.float64)
         hi = np.where(np.isfinite(rng[:, 1]), rng[:, 1], 0.0)
         cap = np.maximum(r_max, hi) + 1.0
-        d = cone_distances(ex, np.asarray(record.alpha), np.asarray(record.gamma), self.edges, cap, self.dense)
+        d = cone_distances(
+            ex, np.asarray(record.alpha), np.asarray(record.gamma), self.edges, cap, self.dense
+        )
         self.poses.append(ex.floats())
         self.ranges.append(np.array([float(v) for v in d]))
         self.exact_poses.append(ex)

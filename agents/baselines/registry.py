@@ -1,0 +1,78 @@
+"""Heuristic coverage baselines for ``digslam/DigCoverage-v0`` with SB3's ``predict`` interface.
+
+* :class:`RandomAgent`: uniform actions;
+* :class:`LawnmowerAgent`: boustrophedon lanes over the world frame, reached through the grid planner;
+* :class:`FrontierAgent`: nearest frontier between clear and dark (then penumbra) ground, Dijkstra over
+  the clear pixels (:mod:`.planning`); it turns in place and drives straight, since the guaranteed
+  observer's box grows about 17 times faster along arcs than along straight lines;
+* :class:`UncertaintyAwareFrontier`: when the tube is wider than a threshold, goes back into clear ground
+  near sensed obstacles, visited while the tube was narrow, and turns there until the tube shrinks (active
+  loop closure).
+
+All read only the observation (:mod:`.policy`). :func:`make_baseline` sizes one from an env.
+
+>>> import gymnasium as gym, digslam.envs
+>>> env = gym.make("digslam/DigCoverage-v0", map_size=36)
+>>> agent = make_baseline("frontier", env)
+>>> obs, _ = env.reset(seed=0)
+>>> action, _ = agent.predict(obs)
+>>> action.shape, bool(env.action_space.contains(action))
+((2,), True)
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from digslam.agents.baselines.frontier import FrontierAgent, LawnmowerAgent, UncertaintyAwareFrontier
+from digslam.agents.baselines.policy import BaselinePolicy, RandomAgent
+
+#: Baseline names and classes.
+BASELINES: dict[str, type[BaselinePolicy]] = {
+    "random": RandomAgent,
+    "lawnmower": LawnmowerAgent,
+    "frontier": FrontierAgent,
+    "uncertainty_frontier": UncertaintyAwareFrontier,
+}
+
+
+def _observer_layer(env: Any) -> Any:
+    """The ``GuaranteedObserver`` layer of a (wrapped) env, or None."""
+    e = env
+    for _ in range(32):
+        if hasattr(e, "grid") and hasattr(e, "filter"):
+            return e
+        if not hasattr(e, "env"):
+            break
+        e = e.env
+    return None
+
+
+def make_baseline(name: str, env: Any, seed: int | None = None) -> BaselinePolicy:
+    """The baseline ``name`` (a key of :data:`BASELINES`) sized from ``env`` (grid span, speeds, ranges).
+
+    Raises:
+        ValueError: ``name`` is not a known baseline.
+    """
+    if name not in BASELINES:
+        raise ValueError(f"name: unknown baseline {name!r}; known: {sorted(BASELINES)}")
+    kw: dict[str, Any] = {}
+    layer = _observer_layer(env)
+    if layer is not None:
+        g = layer.grid
+        raw = layer.env.unwrapped
+        kw.update(span=float(g.hi[0] - g.lo[0]), max_speed=raw.config.max_speed,
+                  max_yaw_rate=raw.config.max_yaw_rate, dt=raw.config.dt,
+                  sensor_range=float(raw.suite.r_max.max()))  # fmt: skip
+    return BASELINES[name](env.action_space, env.observation_space, seed=seed, **kw)
+
+
+__all__ = [
+    "BASELINES",
+    "BaselinePolicy",
+    "FrontierAgent",
+    "LawnmowerAgent",
+    "RandomAgent",
+    "UncertaintyAwareFrontier",
+    "make_baseline",
+]

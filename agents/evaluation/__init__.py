@@ -1,0 +1,8 @@
+"""Evaluating agents: episodes, coverage curves, pictures and Ray-parallel evaluation.
+
+Lives here: :mod:`.evaluate` (``evaluate``, ``EvalResult``, coverage figures), :mod:`.pictures` (demo GIFs
+and their legend) and :mod:`.ray_eval` (the same evaluation spread over Ray workers).
+
+May import: :mod:`digslam.envs`, :mod:`digslam.agents.baselines`, :mod:`digslam.agents.learning.models`;
+matplotlib, imageio, ray (on use).
+"""

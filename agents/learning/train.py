@@ -1,0 +1,388 @@
+"""PPO training on the certified-coverage environments (stable-baselines3), from a config file plus overrides.
+
+:class:`TrainConfig` is a frozen dataclass read from TOML or JSON with ``key=value`` overrides
+(``env_kwargs.map_size=40`` sets one environment keyword); unknown keys and badly typed values raise
+``ValueError`` naming the key. :func:`train` runs SB3's ``PPO("MultiInputPolicy")`` with the
+:class:`~digslam.agents.learning.extractor.MapStateExtractor`, ``SubprocVecEnv`` workers (spawn-safe: the
+factory
+:class:`EnvFactory` is a picklable module-level object and uses the ``"digslam.envs:<id>"`` form),
+TensorBoard logs, checkpoints, evaluation on held-out map seeds and a progress bar. Torch is pinned to
+``torch_threads`` threads in every process (one thread is several times faster on small machines).
+
+>>> cfg = TrainConfig().override(["n_envs=1", "env_kwargs.map_size=40"])
+>>> cfg.n_envs, cfg.env_kwargs["map_size"], cfg.eval_seeds()[:2]
+(1, 40, (500, 501))
+>>> TrainConfig.from_dict({"n_env": 2})  # doctest: +ELLIPSIS
+Traceback (most recent call last):
+...
+ValueError: TrainConfig: unknown key(s) ['n_env']; known: ...
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import signal
+import threading
+import warnings
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    import tomli as tomllib  # type: ignore[no-redef]
+
+#: The default configuration file (the recipe of the shipped policy).
+DEFAULT_CONFIG = Path(__file__).parents[1] / "configs" / "ppo_digcoverage.toml"
+
+
+def _default_env_kwargs() -> dict[str, Any]:
+    return {"map_size": 36, "crop": 4.0, "fixed_world": False}
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """A PPO training run (all fields type-checked; see the module docstring).
+
+    Attributes:
+        env_id: Registered environment id (``digslam/...``).
+        env_kwargs: Keyword arguments of ``gym.make`` (e.g. ``map_size``, ``crop``, ``max_episode_steps``).
+        n_envs: Parallel environments (``SubprocVecEnv`` if > 1).
+        total_timesteps: Environment steps to train for.
+        seed: Seed of the model and of the training envs (env ``i`` is seeded ``seed + i``).
+        learning_rate, n_steps, batch_size, n_epochs, gamma, ent_coef: PPO's hyperparameters (``n_steps``
+            per environment).
+        features_dim: Output size of the features extractor.
+        eval_freq: Timesteps between evaluations on the held-out maps (0: none).
+        eval_maps: Number of held-out maps (seeds ``eval_seed, eval_seed + 1, ...``).
+        eval_seed: First held-out seed; the held-out seeds must not meet the training seeds.
+        checkpoint_freq: Timesteps between checkpoints (0: none).
+        out_dir: Folder for the model, checkpoints, TensorBoard logs and evaluations.
+        device: Torch device (``"cpu"``).
+        torch_threads: Torch threads per process.
+        progress_bar: Show SB3's progress bar.
+        verbose: SB3 verbosity.
+    """
+
+    env_id: str = "digslam/DigCoverage-v0"
+    env_kwargs: dict[str, Any] = field(default_factory=_default_env_kwargs)
+    n_envs: int = 2
+    total_timesteps: int = 245_760
+    seed: int = 0
+    learning_rate: float = 3e-4
+    n_steps: int = 512
+    batch_size: int = 128
+    n_epochs: int = 4
+    gamma: float = 0.99
+    ent_coef: float = 0.0
+    features_dim: int = 128
+    eval_freq: int = 40_960
+    eval_maps: int = 3
+    eval_seed: int = 500
+    checkpoint_freq: int = 10_240
+    out_dir: str = "runs/ppo_digcoverage"
+    device: str = "cpu"
+    torch_threads: int = 1
+    progress_bar: bool = True
+    verbose: int = 0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            v = getattr(self, f.name)
+            want = {"dict[str, Any]": dict, "float": float, "int": int, "str": str, "bool": bool}[str(f.type)]
+            if want is float and isinstance(v, int) and not isinstance(v, bool):
+                object.__setattr__(self, f.name, float(v))
+            elif not isinstance(v, want) or (want is int and isinstance(v, bool)):
+                raise ValueError(f"{f.name}: must be {want.__name__}, got {v!r} ({type(v).__name__})")
+        positive = ("n_envs", "total_timesteps", "n_steps", "batch_size", "n_epochs", "features_dim",
+                    "eval_maps", "torch_threads")  # fmt: skip
+        for name in positive:
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name}: must be >= 1, got {getattr(self, name)!r}")
+        for name in ("eval_freq", "checkpoint_freq", "ent_coef", "seed", "eval_seed"):
+            if getattr(self, name) < 0:
+                raise ValueError(f"{name}: must be >= 0, got {getattr(self, name)!r}")
+        if not 0.0 < self.learning_rate < 1.0:
+            raise ValueError(f"learning_rate: must be in (0, 1), got {self.learning_rate!r}")
+        if not 0.0 < self.gamma <= 1.0:
+            raise ValueError(f"gamma: must be in (0, 1], got {self.gamma!r}")
+        if set(self.train_seeds()) & set(self.eval_seeds()):
+            raise ValueError(
+                f"eval_seed: held-out seeds {self.eval_seeds()} meet the training seeds {self.train_seeds()}"
+            )
+
+    def train_seeds(self) -> tuple[int, ...]:
+        """Seeds of the training environments."""
+        return tuple(range(self.seed, self.seed + self.n_envs))
+
+    def eval_seeds(self) -> tuple[int, ...]:
+        """Seeds of the held-out evaluation maps."""
+        return tuple(range(self.eval_seed, self.eval_seed + self.eval_maps))
+
+    # --- construction -------------------------------------------------------------------------------------
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> TrainConfig:
+        """Build from a mapping; unknown keys raise ``ValueError`` naming them."""
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ValueError(f"TrainConfig: unknown key(s) {unknown}; known: {sorted(known)}")
+        return cls(**dict(data))
+
+    @classmethod
+    def from_file(cls, path: str | Path | None = None, overrides: Iterable[str] = ()) -> TrainConfig:
+        """Read a ``.toml`` or ``.json`` file (None: :data:`DEFAULT_CONFIG`), then apply ``overrides``."""
+        p = Path(path) if path is not None else DEFAULT_CONFIG
+        if not p.is_file():
+            raise ValueError(f"path: no configuration file {str(p)!r}")
+        if p.suffix not in (".json", ".toml"):
+            raise ValueError(f"path: configuration must be .toml or .json, got {str(p)!r}")
+        try:
+            text = p.read_text()
+            data = json.loads(text) if p.suffix == ".json" else tomllib.loads(text)
+        except (OSError, UnicodeDecodeError, ValueError) as exc:  # TOMLDecodeError, JSONDecodeError
+            raise ValueError(f"path: cannot read {str(p)!r} as {p.suffix[1:].upper()} ({exc})") from None
+        if not isinstance(data, dict):
+            raise ValueError(f"path: {str(p)!r} must hold a table of settings, got {type(data).__name__}")
+        return cls.from_dict(data).override(overrides)
+
+    def override(self, overrides: Iterable[str]) -> TrainConfig:
+        """Apply ``key=value`` strings (values parsed as TOML literals, else taken as strings)."""
+        data = dataclasses.asdict(self)
+        for item in overrides:
+            key, sep, raw = item.partition("=")
+            key = key.strip()
+            if not sep or not key:
+                raise ValueError(f"overrides: expected key=value, got {item!r}")
+            value = parse_value(raw.strip())
+            head, _, sub = key.partition(".")
+            if head not in data:
+                raise ValueError(f"{head}: unknown key; known: {sorted(data)}")
+            if sub:
+                if head != "env_kwargs":
+                    raise ValueError(f"{key}: only env_kwargs takes dotted keys")
+                data[head] = {**data[head], sub: value}
+            else:
+                data[head] = value
+        return TrainConfig.from_dict(data)
+
+
+def parse_value(raw: str) -> Any:
+    """A TOML literal (``3``, ``1e-4``, ``true``, ``"x"``, ``{map_size = 40}``), or the raw string."""
+    try:
+        return tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        return raw
+
+
+def pin_threads(n: int) -> None:
+    """Pin torch (and the BLAS/OpenMP pools of child processes) to ``n`` threads."""
+    for var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
+        os.environ[var] = str(n)
+    import torch
+
+    torch.set_num_threads(n)
+
+
+class SeedCycle(gym.Wrapper):
+    """Unseeded resets walk through ``seeds`` in turn (the held-out maps of the evaluation callback)."""
+
+    def __init__(self, env: gym.Env, seeds: tuple[int, ...]) -> None:
+        super().__init__(env)
+        self.seeds, self.k = tuple(seeds), 0
+
+    def reset(self, *, seed: int | None = None, options: Any = None) -> Any:
+        if seed is None:
+            seed, self.k = self.seeds[self.k % len(self.seeds)], self.k + 1
+        return self.env.reset(seed=seed, options=options)
+
+
+@dataclass(frozen=True)
+class EnvFactory:
+    """Picklable environment factory for vectorized envs (``spawn``-safe).
+
+    Args:
+        env_id: Registered id; made as ``"digslam.envs:<id>"`` so a fresh worker imports the package.
+        env_kwargs: ``gym.make`` keyword arguments.
+        torch_threads: Torch threads in the worker.
+        seeds: If given, unseeded resets cycle through these seeds (held-out evaluation maps).
+    """
+
+    env_id: str
+    env_kwargs: Mapping[str, Any] = field(default_factory=dict)
+    torch_threads: int = 1
+    seeds: tuple[int, ...] | None = None
+
+    def __call__(self) -> Any:
+        from stable_baselines3.common.monitor import Monitor
+
+        pin_threads(self.torch_threads)
+        env_id = self.env_id if ":" in self.env_id else f"digslam.envs:{self.env_id}"
+        env = gym.make(env_id, **dict(self.env_kwargs))
+        if self.seeds:
+            env = SeedCycle(env, self.seeds)
+        return Monitor(env)
+
+
+def make_vec_env(factory: EnvFactory, n: int, seed: int) -> Any:
+    """``n`` copies of ``factory``: a ``DummyVecEnv`` if ``n == 1``, else a spawn ``SubprocVecEnv``;
+    env ``i`` is seeded ``seed + i``."""
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
+
+    fns = [factory] * n
+    vec = DummyVecEnv(fns) if n == 1 else SubprocVecEnv(fns, start_method="spawn")
+    vec.seed(seed)
+    return vec
+
+
+def build_model(cfg: TrainConfig, env: Any, tensorboard_log: str | None = None) -> Any:
+    """The PPO model of ``cfg`` on the vectorized ``env``."""
+    from stable_baselines3 import PPO
+
+    from digslam.agents.learning.extractor import MapStateExtractor
+
+    policy_kwargs = {
+        "features_extractor_class": MapStateExtractor,
+        "features_extractor_kwargs": {"features_dim": cfg.features_dim},
+        "net_arch": {"pi": [64], "vf": [64]},
+    }
+    return PPO(
+        "MultiInputPolicy",
+        env,
+        learning_rate=cfg.learning_rate,
+        n_steps=cfg.n_steps,
+        batch_size=cfg.batch_size,
+        n_epochs=cfg.n_epochs,
+        gamma=cfg.gamma,
+        ent_coef=cfg.ent_coef,
+        policy_kwargs=policy_kwargs,
+        tensorboard_log=tensorboard_log,
+        seed=cfg.seed,
+        device=cfg.device,
+        verbose=cfg.verbose,
+    )
+
+
+class TrainingInterrupted(KeyboardInterrupt):
+    """Ctrl-C during :func:`train`: the model so far was saved to ``path`` after ``timesteps`` steps."""
+
+    def __init__(self, path: Path, timesteps: int) -> None:
+        super().__init__(f"interrupted after {timesteps} timesteps; saved {path}")
+        self.path, self.timesteps = path, timesteps
+
+
+def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = None) -> Path:
+    """Train PPO as ``cfg`` says; returns the saved final model (``<out_dir>/final_model.zip``).
+
+    ``callbacks`` are extra SB3 callbacks given to ``learn`` (e.g. the Ray Tune reporter of
+    :mod:`.sweep`). ``worker_guard`` is a context manager held while the worker processes start (the
+    command line's ignores SIGINT there, so Ctrl-C reaches the main process only). Ctrl-C during ``learn``
+    saves the model so far to ``<out_dir>/interrupted_model.zip`` and raises :class:`TrainingInterrupted`:
+    in the main thread SIGINT only sets a flag that a callback reads at the next environment step, so the
+    signal never lands inside a kernel being compiled or a half-done update.
+
+    ``out_dir`` also gets ``config.json``, ``checkpoints/``, ``tb/`` (TensorBoard), and with evaluation
+    ``best_model.zip`` and ``eval/evaluations.npz`` (held-out maps ``cfg.eval_seeds()``).
+    """
+    from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
+
+    class _StopOnSigint(BaseCallback):  # type: ignore[misc]
+        """Stops ``learn`` at the next step once SIGINT has set the flag."""
+
+        def __init__(self) -> None:
+            super().__init__()
+            self.flag = False
+
+        def _on_step(self) -> bool:
+            return not self.flag
+
+    pin_threads(cfg.torch_threads)
+    out = Path(cfg.out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "config.json").write_text(json.dumps(dataclasses.asdict(cfg), indent=2))
+    try:
+        import tensorboard  # noqa: F401
+
+        tb: str | None = str(out / "tb")
+    except ImportError:
+        tb = None
+    import contextlib
+
+    with worker_guard if worker_guard is not None else contextlib.nullcontext():
+        env = make_vec_env(EnvFactory(cfg.env_id, cfg.env_kwargs, cfg.torch_threads), cfg.n_envs, cfg.seed)
+    callbacks = list(callbacks)
+    eval_env = None
+    try:
+        if cfg.checkpoint_freq:
+            every = max(cfg.checkpoint_freq // cfg.n_envs, 1)
+            callbacks.append(CheckpointCallback(every, str(out / "checkpoints"), name_prefix="ppo"))
+        if cfg.eval_freq:
+            seeds = cfg.eval_seeds()
+            held_out = EnvFactory(cfg.env_id, cfg.env_kwargs, cfg.torch_threads, seeds)
+            eval_env = make_vec_env(held_out, 1, seeds[0])
+            callbacks.append(
+                EvalCallback(
+                    eval_env,
+                    n_eval_episodes=cfg.eval_maps,
+                    eval_freq=max(cfg.eval_freq // cfg.n_envs, 1),
+                    log_path=str(out / "eval"),
+                    best_model_save_path=str(out),
+                    deterministic=True,
+                    verbose=cfg.verbose,
+                )
+            )
+        model = build_model(cfg, env, tb)
+        bar = _has_progress() and cfg.progress_bar
+        with warnings.catch_warnings():  # Subproc training env vs Dummy eval env is intended
+            warnings.filterwarnings("ignore", message="Training and eval env are not of the same type")
+            stop = _StopOnSigint()
+            main = threading.current_thread() is threading.main_thread()
+            old = signal.signal(signal.SIGINT, lambda *_: setattr(stop, "flag", True)) if main else None
+            try:
+                model.learn(cfg.total_timesteps, callback=[*callbacks, stop], progress_bar=bar)
+                interrupted = stop.flag
+            except KeyboardInterrupt:
+                interrupted = True
+            finally:
+                if main:
+                    signal.signal(signal.SIGINT, old)
+            if interrupted:
+                path = out / "interrupted_model.zip"
+                _save(model, path)
+                raise TrainingInterrupted(path, int(model.num_timesteps)) from None
+        path = out / "final_model.zip"
+        _save(model, path)
+    finally:
+        env.close()
+        if eval_env is not None:
+            eval_env.close()
+    return path
+
+
+def _save(model: Any, path: Path) -> None:
+    """``model.save`` to a scratch file, then renamed: an interrupted save leaves no half-written model."""
+    tmp = path.with_name(f".{path.stem}.part{os.getpid()}.zip")
+    try:
+        model.save(tmp)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def _has_progress() -> bool:
+    try:
+        import rich  # noqa: F401
+        import tqdm  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+__all__ = ["DEFAULT_CONFIG", "EnvFactory", "SeedCycle", "TrainConfig", "TrainingInterrupted", "build_model",
+           "make_vec_env", "parse_value", "pin_threads", "train"]  # fmt: skip

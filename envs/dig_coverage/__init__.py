@@ -1,0 +1,72 @@
+"""The certified-coverage Gymnasium family ``digslam/DigCoverage-*``: the raw env under the guaranteed
+observer.
+
+Lives here: :mod:`.config` (``ObserverConfig``, ``DigCoverageConfig``), :mod:`.wrapper`
+(``GuaranteedObserver``: runs the online observer and builds observations from its sets only),
+:mod:`.maps_jit` (the observation maps' kernels), :mod:`.monitor` (``GuaranteeMonitor``, checks every claim
+against the truth) and :mod:`.env` (``DigCoverageEnv``, reward and ``RGB`` palette).
+
+May import: all of :mod:`digslam.observer`, :mod:`digslam.envs.explore` and below; gymnasium, numpy.
+"""
+
+from .config import (
+    NATURE_CNN_MIN,
+    DigCoverageConfig,
+    ObserverConfig,
+)
+from .env import (
+    OBSTACLE_RGB,
+    RENDER_SIZE,
+    RGB,
+    DigCoverageEnv,
+)
+from .maps_jit import (
+    all_blocks,
+    block_starts,
+    crop_window,
+    fill_map,
+    observe,
+    observer_sets,
+    pixel_blocks,
+    pixel_range,
+    sets_and_map,
+    three_state,
+)
+from .monitor import (
+    SENSED_SAMPLES,
+    GuaranteeMonitor,
+    GuaranteeViolation,
+)
+from .wrapper import (
+    N_STATE,
+    GuaranteedObserver,
+    make_grid,
+    reachable_free,
+)
+
+__all__ = [
+    "DigCoverageConfig",
+    "DigCoverageEnv",
+    "GuaranteeMonitor",
+    "GuaranteeViolation",
+    "GuaranteedObserver",
+    "NATURE_CNN_MIN",
+    "N_STATE",
+    "OBSTACLE_RGB",
+    "ObserverConfig",
+    "RENDER_SIZE",
+    "RGB",
+    "SENSED_SAMPLES",
+    "all_blocks",
+    "block_starts",
+    "crop_window",
+    "fill_map",
+    "make_grid",
+    "observe",
+    "observer_sets",
+    "pixel_blocks",
+    "pixel_range",
+    "reachable_free",
+    "sets_and_map",
+    "three_state",
+]

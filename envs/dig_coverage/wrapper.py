@@ -1,0 +1,325 @@
+"""``GuaranteedObserver``: the online Dig-SLAM filter (thesis §6.4, Algorithm 6.3) wrapped around the raw env.
+
+At every step the filter (:class:`~digslam.observer.online.observer.OnlineDigSlam`) turns the bounded record
+into the
+pose box, the dig zone ``M⁻`` and the explored thick set, and the wrapper hands them to the agent:
+
+* ``"map"``: ``uint8 (C, m, m)`` channels-first image (SB3 image convention, values 0 / 255): clear,
+  penumbra, dark (conservative downsampling, :mod:`.observer_maps`), the pose-box footprint, and with
+  ``crop`` three more channels clear / penumbra / dark of a ``crop`` x ``crop`` m window centred on the pose
+  box (world-aligned; outside the grid counts as dark);
+* ``"state"``: ``float32 (11,)``: the pose box ``(x⁻, y⁻, x⁺, y⁺)`` normalised to ``[-1, 1]`` over the grid
+  frame, ``cos``/``sin`` of the mid heading and the heading half-width over ``π``, ``tanh`` of the tube width
+  (m), the elapsed share of ``horizon``, the certified coverage and the consistency flag.
+
+``info`` adds the sets as arrays (``explored`` int8 CLEAR/PENUMBRA/DARK, ``dig`` and ``clear`` bool, all
+``(ny, nx)`` with row 0 at the top; ``pose_box (2, 2)``, ``heading_box (2,)``), ``certified_coverage``
+(clear cells in the reachable free area over that area, :func:`reachable_free`), ``clear_area`` (m²),
+``true_coverage`` (the ground truth over the same cells: the share of the reachable free cells whose centre
+was truly sensed, so ``certified_coverage <= true_coverage`` at every step, checked by ``monitor=True``)
+and ``consistent`` / ``inconsistent_step``.
+If the filter finds the data inconsistent (an empty pose box) it stops, every claim is withdrawn (the map
+becomes all penumbra) and the episode is truncated.
+
+**What is promised, and when the data break their bounds.** The claims (the true position lies in the pose
+box and the heading in its interval; every dug or clear cell holds no obstacle point; every clear cell was
+sensed, no dark cell was) are proved under a premise on the records; the filter never reads the record's
+``outlier`` flag.
+
+* ``q = 0`` (default): premise, *every* interval of every record contains the truth. If one range reading
+  misses it, nothing is promised from that step on: the filter notices only when the data make the pose
+  box empty, which may be steps later or never, and until then the reading's claims stand. One false long
+  echo (or a range shifted up by 0.3 m) digs through a rock at once: obstacle cells claimed free and clear.
+  Detection then withdraws every claim (and truncates the episode), but what the agent was shown before
+  was false.
+* ``q >= 1`` (``ObserverConfig(q=q)``, the filter's q-relaxed mode, thesis §2.6.2): premise, the
+  odometry, compass and start box hold and *at most* ``q`` *of the range readings of each step* miss the
+  truth (any readings, unflagged, possibly different ones each step). Then no claim is false, at any step:
+  a cell is dug or clear only where ``q + 1`` readings of the step prove it free, the pose box is the hull of
+  the positions consistent with all but ``q`` echoes, and the possibly sensed zone grows with the maximum
+  ranges (:class:`~digslam.observer.online.observer.OnlineDigSlam`). This is the documented way to get no
+  false
+  claim from up to ``q`` bad readings per step; it costs coverage (fewer cells are proved) and some update
+  time. With more than ``q`` bad readings in a step the ``q = 0`` statement applies again: an empty box is
+  still reported, but claims made before may be false.
+
+``digslam/DigCoverageOutliers-v0`` pairs the two: outliers capped at ``q = 1`` per step
+(``noise.max_outliers``) and an observer with ``q = 1``.
+
+Records go to the filter as they come: record ``k``'s odometry bounds the step that ends at ``t_k``, the
+data contract of :mod:`digslam.observer.slam.record` that both the env and the filter follow.
+
+>>> from digslam.envs.explore.env import ExploreEnv
+>>> env = GuaranteedObserver(ExploreEnv(), map_size=36)
+>>> obs, info = env.reset(seed=0)
+>>> obs["map"].shape, obs["map"].dtype.name, obs["state"].shape, info["consistent"]
+((4, 36, 36), 'uint8', (11,), True)
+>>> bool(info["pose_box"][0, 0] <= info["truth"].pose[0] <= info["pose_box"][1, 0])
+True
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from scipy import ndimage
+
+from digslam.envs.dig_coverage.config import ObserverConfig
+from digslam.envs.dig_coverage.maps_jit import _observe, crop_window, fill_map, pixel_blocks
+from digslam.envs.dig_coverage.monitor import GuaranteeMonitor
+from digslam.envs.sim.coverage import Coverage
+from digslam.envs.world.raster import FREE, rasterize
+from digslam.envs.world.world import World
+from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam
+from digslam.observer.slam.grid import Grid
+from digslam.observer.slam.record import MissionRecord
+from digslam.observer.thick.sep import PENUMBRA
+
+N_STATE = 11
+
+
+def make_grid(cfg: ObserverConfig, world_frame: tuple[float, ...]) -> Grid:
+    """The observer grid over ``cfg.grid_frame`` (default: the world frame); it must cover the world."""
+    f = cfg.grid_frame or tuple(float(v) for v in world_frame)
+    w = world_frame
+    if not (f[0] <= w[0] and f[1] <= w[1] and f[2] >= w[2] and f[3] >= w[3]):
+        raise ValueError(f"grid_frame: {f} does not cover the world frame {tuple(w)}")
+    n = max(int(math.ceil((f[2] - f[0]) / cfg.grid_cell - 1e-9)), 1)
+    return Grid((f[0], f[1]), (f[2], f[3]), (n, n))
+
+
+def reachable_free(world: World, grid: Grid, start: np.ndarray, sub: int = 4) -> np.ndarray:
+    """``(ny, nx)`` bool: cells entirely free in the exact raster and connected to the start.
+
+    Connectivity is taken on a raster ``sub`` times finer (8-connected free fine cells), so passages
+    narrower than an observer cell still connect the free space beyond them; a grid cell counts when it is
+    entirely free and its fine cells belong to the start's component.
+    """
+    x0, y0, x1, _ = grid.lo + grid.hi
+    ny, nx = grid.shape
+    res = (x1 - x0) / nx
+    frame = (x0, y0, grid.hi[0], grid.hi[1])
+    fine = rasterize(world.edges, frame, res / sub)[::-1] == FREE  # row 0 at the top
+    fine = fine[: ny * sub, : nx * sub]
+    labels, _ = ndimage.label(fine, structure=np.ones((3, 3), dtype=bool))
+    col = int(Grid.count_below(grid.xs, np.array([start[0]]))[0]) - 1
+    row = int(Grid.count_below(-grid.ys, np.array([-start[1]]))[0]) - 1
+    r, c = min(max(row, 0), ny - 1) * sub, min(max(col, 0), nx - 1) * sub
+    block = labels[r : r + sub, c : c + sub]
+    lab = int(block.max())  # the start cell's component (its free fine cells are connected)
+    if not lab:
+        return np.zeros(grid.shape, dtype=bool)
+    coarse = rasterize(world.edges, frame, res)[::-1][:ny, :nx] == FREE
+    inside = (labels == lab).reshape(ny, sub, nx, sub).all(axis=(1, 3))
+    return coarse & inside
+
+
+class GuaranteedObserver(gym.Wrapper):
+    """The online guaranteed observer as a ``gymnasium`` wrapper (see the module docstring).
+
+    Args:
+        env: an :class:`~digslam.envs.explore.env.ExploreEnv` (possibly wrapped).
+        grid_cell, map_size, crop, monitor, q: override the fields of ``config`` (``q`` also sets the
+            filter's ``OnlineConfig.q``).
+        config: an :class:`ObserverConfig`, a mapping, or an ``OnlineConfig`` (filter settings only).
+
+    When ``env`` is the raw env itself (no wrapper between), :meth:`step` calls its internal fast path
+    ``_step(action, observe=False)``: the agent sees this wrapper's observation only, so the raw one is not
+    built on each step. The raw env's own ``step`` keeps the Gymnasium contract.
+    """
+
+    def __init__(
+        self,
+        env: gym.Env,
+        grid_cell: float | None = None,
+        map_size: int | None = None,
+        crop: float | None = None,
+        monitor: bool | None = None,
+        config: ObserverConfig | OnlineConfig | Mapping[str, Any] | None = None,
+        q: int | None = None,
+    ) -> None:
+        super().__init__(env)
+        if isinstance(config, OnlineConfig):
+            config = ObserverConfig(online=config)
+        cfg = config if isinstance(config, ObserverConfig) else ObserverConfig.from_dict(config or {})
+        over = {"grid_cell": grid_cell, "map_size": map_size, "crop": crop, "monitor": monitor}
+        cfg = cfg.replace(**{k: v for k, v in over.items() if v is not None})
+        if q is not None:
+            if not (isinstance(q, int) and not isinstance(q, bool) and q >= 0):
+                raise ValueError(f"q: must be an integer >= 0 (outliers allowed per step), got {q!r}")
+            cfg = cfg.replace(q=q, online=dataclasses.replace(cfg.online, q=q))
+        self.obs_config = cfg
+        raw = env.unwrapped
+        self.grid = make_grid(cfg, raw.generator.frame)
+        m = cfg.map_size
+        self.n_channels = 4 + (3 if cfg.crop is not None else 0)
+        self.observation_space = spaces.Dict(
+            {
+                "map": spaces.Box(0, 255, shape=(self.n_channels, m, m), dtype=np.uint8),
+                "state": spaces.Box(-1.0, 1.0, shape=(N_STATE,), dtype=np.float32),
+            }
+        )
+        self.filter = OnlineDigSlam(self.grid, cfg.online)
+        # nothing between reads the raw observation, which this wrapper replaces: skip building it
+        self._fast = env is raw
+        self._extra_info: dict[str, Any] = {}  # constant keys added to every info (subclasses)
+        g = self.grid
+        self.cell_area = g.cell_size[0] * g.cell_size[1]
+        self._centre = 0.5 * (np.array(g.lo) + np.array(g.hi))
+        self._half = 0.5 * (np.array(g.hi) - np.array(g.lo))
+        self._norm = np.array([*self._centre, *self._half, cfg.horizon], dtype=np.float64)  # for _observe
+        self._blocks = pixel_blocks(g.shape, cfg.map_size)
+        self._obs: tuple[np.ndarray, np.ndarray] = (np.zeros(0, np.uint8), np.zeros(0, np.float32))
+        self._reach_world: Any = None
+        self.reachable = np.zeros(g.shape, dtype=bool)
+        self.monitor: GuaranteeMonitor | None = None
+        self.steps, self._cache_step = 0, -1
+        self._cache: tuple[np.ndarray, np.ndarray, np.ndarray, int] = (np.zeros(0),) * 3 + (0,)
+        self._dig_copy = np.zeros(0, bool)
+        m, shape = cfg.map_size, g.shape
+        self._planes = np.zeros((4, *shape), np.uint8)  # explored (int8), clear, dark, reachable: observe()
+        self._explored_all, self._clear_all = self._planes[0].view(np.int8), self._planes[1].view(np.bool_)
+        self._dark_all, self._base, self._n = self._planes[2].view(np.bool_), np.zeros((3, m, m), np.uint8), 0
+
+    # --- gymnasium API -------------------------------------------------------------------------------------
+    def reset(self, **kwargs: Any) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        _, info = self.env.reset(**kwargs)
+        raw = self.env.unwrapped
+        truth = info["truth"]
+        self.grid_check(raw.world)
+        if self._reach_world is not raw.world or not self._in_reach(truth.pose):  # once per world and start
+            self.reachable = reachable_free(raw.world, self.grid, truth.pose)
+            self.n_reachable = max(int(np.count_nonzero(self.reachable)), 1)
+            self._planes[3] = self.reachable
+            self._reach_world = raw.world
+        b = self.obs_config.start_box
+        p = truth.pose[:2]
+        lo = np.maximum(p - b, np.array(self.grid.lo))
+        hi = np.minimum(p + b, np.array(self.grid.hi))
+        self.filter.reset(lo, hi, info["record"])
+        self.steps, self._cache_step = 0, -1
+        # ground truth over the cells of the certified coverage, the reachable free area (:mod:`.coverage`)
+        self.truth_coverage = Coverage.on_cells(self.reachable[::-1], self.grid.lo, self.grid.cell_size,
+                                                float(raw.suite.r_max.max()))  # fmt: skip
+        self.truth_coverage.update(truth.pose, raw.suite, truth.ranges)
+        raw.measure_coverage_on(self.truth_coverage)  # the raw env updates it each step (its reward too)
+        self.monitor = (GuaranteeMonitor(raw.world, self.grid, coverage=(self.reachable, self.truth_coverage))
+                        if self.obs_config.monitor else None)  # fmt: skip
+        self._check(info)
+        self._clear_count = self._certified_count()
+        return self.observation(), self._obs_info(info)
+
+    def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        step = self.env._step(action, observe=False) if self._fast else self.env.step(action)
+        _, reward, terminated, truncated, info = step
+        self.filter.update(info["record"])  # :meth:`_feed`, inlined
+        self.steps += 1
+        if self.monitor is not None:
+            self.monitor.check(self.filter, info["truth"], info["record"], self.steps)
+        truncated = truncated or not self.filter.consistent
+        return self.observation(), float(reward), terminated, truncated, self._obs_info(info)
+
+    # --- pieces ---------------------------------------------------------------------------------------------
+    def _in_reach(self, pose: np.ndarray) -> bool:
+        g = self.grid
+        c = int(Grid.count_below(g.xs, np.array([pose[0]]))[0]) - 1
+        r = int(Grid.count_below(-g.ys, np.array([-pose[1]]))[0]) - 1
+        return 0 <= r < g.shape[0] and 0 <= c < g.shape[1] and bool(self.reachable[r, c])
+
+    def grid_check(self, world: World) -> None:
+        """Raise ``ValueError`` if the grid does not cover ``world``'s frame."""
+        make_grid(self.obs_config.replace(grid_frame=self.grid.lo + self.grid.hi), world.frame)
+
+    def _feed(self, rec: MissionRecord) -> None:
+        """Fold the env's record into the filter."""
+        self.filter.update(rec)
+        self.steps += 1
+
+    def _check(self, info: dict[str, Any]) -> None:
+        if self.monitor is not None:
+            self.monitor.check(self.filter, info["truth"], info["record"], self.steps)
+
+    def _sets(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+        """The filter's explored codes, clear and dark masks and certified cell count, once per step, with
+        the observation (:meth:`observation`): one compiled call (the kernel of
+        :func:`.observer_maps.observe`) keeps the sets and the map's clear / penumbra / dark channels up to
+        date on the cells the step touched (:meth:`OnlineDigSlam.take_touched`) and draws the pose-box channel
+        and the state; ``info`` gets copies of the sets."""
+        if self._cache_step != self.steps:
+            f, (ny, nx) = self.filter, self.grid.shape
+            win = f.take_touched()
+            if win == (0, ny, 0, nx):  # after a reset: everything (and the reachable area may be new)
+                self._clear_all[:] = False
+                self._n = 0
+            m = self.obs_config.map_size
+            img, state = np.empty((self.n_channels, m, m), np.uint8), np.empty(N_STATE, dtype=np.float32)
+            d, snap = f.dig, np.empty((3, ny, nx), np.uint8)  # info's explored, clear and dig
+            self._n = int(_observe(f.sensed_sure, f.sensed_maybe, d.free, self._planes, self._base, img,
+                                   self._blocks, *win, d.xs, d.nys, f.pose_lo, f.pose_hi, f.heading_lo,
+                                   f.heading_hi, self._norm, self.steps, self.n_reachable, self._n, state,
+                                   snap))  # fmt: skip
+            if self.obs_config.crop is not None:
+                self._crop(img)
+            self._obs = (img, state)
+            self._cache = (snap[0].view(np.int8), snap[1].view(np.bool_), self._dark_all, self._n)
+            self._dig_copy = snap[2].view(np.bool_)
+            self._cache_step = self.steps
+        return self._cache
+
+    def _crop(self, img: np.ndarray) -> None:
+        """Channels 4-6: clear / penumbra / dark of the ``crop`` window centred on the pose box."""
+        f, g = self.filter, self.grid
+        k = max(int(math.ceil(self.obs_config.crop / g.cell_size[0])), 1)
+        ctr = 0.5 * (f.pose_lo + f.pose_hi)
+        rc = int(Grid.count_below(-g.ys, np.array([-ctr[1]]))[0]) - 1
+        cc = int(Grid.count_below(g.xs, np.array([ctr[0]]))[0]) - 1
+        a, b = rc - k // 2, cc - k // 2
+        clear, dark = crop_window(self._clear_all, a, b, k, False), crop_window(self._dark_all, a, b, k, True)
+        fill_map(clear, dark, img, 4)
+
+    def _certified_count(self) -> int:
+        """Clear cells in the reachable free area (0 once the claims are withdrawn)."""
+        return self._sets()[3] if self.filter.consistent else 0
+
+    def observation(self) -> dict[str, np.ndarray]:
+        """The ``"map"`` and ``"state"`` of the filter's current sets (serves reset and step)."""
+        if not self.filter.consistent:  # claims withdrawn: everything is penumbra
+            m = self.obs_config.map_size
+            img = np.zeros((self.n_channels, m, m), dtype=np.uint8)
+            img[1] = 255
+            return {"map": img, "state": np.zeros(N_STATE, dtype=np.float32)}
+        self._sets()
+        img, state = self._obs
+        return {"map": img, "state": state}
+
+    def _obs_info(self, info: dict[str, Any]) -> dict[str, Any]:
+        f = self.filter
+        if f.consistent:
+            explored, clear, _, n = self._sets()
+            return {**info, "explored": explored, "dig": self._dig_copy, "clear": clear,
+                    "pose_box": np.array((f.pose_lo, f.pose_hi), np.float64),
+                    "heading_box": np.array((f.heading_lo, f.heading_hi), np.float64),
+                    "certified_coverage": n / self.n_reachable, "clear_area": n * self.cell_area,
+                    "true_coverage": self.truth_coverage.fraction, "consistent": True,
+                    "inconsistent_step": f.inconsistent_step, **self._extra_info}  # fmt: skip
+        shape = self.grid.shape
+        return {**info, "explored": np.full(shape, PENUMBRA), "dig": np.zeros(shape, dtype=bool),
+                "clear": np.zeros(shape, bool), "pose_box": np.full((2, 2), np.nan),
+                "heading_box": np.full(2, np.nan), "certified_coverage": 0 / self.n_reachable,
+                "clear_area": 0 * self.cell_area, "true_coverage": self.truth_coverage.fraction,
+                "consistent": False, "inconsistent_step": f.inconsistent_step,
+                **self._extra_info}  # fmt: skip
+
+
+__all__ = [
+    "GuaranteedObserver",
+    "N_STATE",
+    "make_grid",
+    "reachable_free",
+]

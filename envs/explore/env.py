@@ -1,0 +1,244 @@
+"""``digslam/Explore-v0``: a disc robot with exact sonar cones exploring an unknown world.
+
+Action: normalised ``(v, omega)`` in ``[-1, 1]^2``. Observation (dict): range intervals ``ranges (n, 2)``
+(``[r_max, top]`` where no echo), ``no_echo (n,)``, ``odometry (2, 2)`` (speed and yaw-rate intervals over
+the step just ended) and ``heading (2,)`` (compass interval, shifted by a multiple of 2 pi into about
+``[-pi, pi]``). Reward: the newly and truly sensed free area (m^2). ``info`` holds the
+:class:`~digslam.observer.slam.record.MissionRecord` under ``"record"`` and the
+:class:`~digslam.envs.explore.episode.GroundTruth` under ``"truth"``.
+
+Record convention (record ``j`` is the one returned at time ``t_j``; ``j = 0`` by ``reset``):
+
+* ``heading[j]`` bounds the true heading at ``t_j`` and ``range[j]`` the exact distances from the pose at
+  ``t_j``;
+* ``speed[j]`` and ``yaw_rate[j]`` bound the true values over the WHOLE step that just ended,
+  ``[t_{j-1}, t_j]`` (the hull over all its physics substeps, see :mod:`.robot`), not instantaneous values;
+  record 0 carries the robot at rest, ``[0, 0]`` widened by the noise bound.
+
+This is the data contract of :mod:`digslam.observer.slam.record`, which the observers (offline ``dig_slam``,
+the online filter of :mod:`.observer_wrapper`) read as it is. Every bound contains the exact truth,
+floating point included: the truth is the chain of exact arcs of :mod:`.arc` (the stored heading is exact,
+the stored position within the proved ``truth.pose_error``), the odometry hulls are the pieces' exact speeds
+and outward-rounded yaw rates, and the ranges are rigorous bounds around the true pose
+(:meth:`~.sensors.SensorSuite.range_bounds`). Each step lasts exactly the time between its two records.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from digslam.envs.config import ExploreConfig
+from digslam.envs.explore.episode import GroundTruth
+from digslam.envs.sim.arc_jit import exact_duration
+from digslam.envs.sim.coverage import Coverage
+from digslam.envs.sim.noise_jit import obs_kernel
+from digslam.envs.sim.robot import RobotSim
+from digslam.envs.sim.sensors import SensorSuite, measure_step
+from digslam.envs.world.generators import GENERATORS, WorldGenerator
+from digslam.envs.world.world import World
+from digslam.observer.slam.record import MissionRecord
+
+
+def _generator(cfg: ExploreConfig) -> WorldGenerator:
+    if cfg.world == "file":
+        return GENERATORS["file"](cfg.map_path, size=cfg.world_size)  # type: ignore[call-arg]
+    if cfg.world == "rocks":
+        return GENERATORS["rocks"](size=cfg.world_size, n=cfg.n_obstacles)  # type: ignore[call-arg]
+    return GENERATORS[cfg.world](size=cfg.world_size)
+
+
+class ExploreEnv(gym.Env):
+    """Exploration environment; see the module docstring.
+
+    Args:
+        config: An :class:`ExploreConfig`, a mapping, or None for the defaults.
+        render_mode: ``"rgb_array"``, ``"human"`` or None.
+        **overrides: Config fields overriding ``config`` (unknown keys raise ``ValueError``).
+    """
+
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
+
+    def __init__(
+        self,
+        config: ExploreConfig | Mapping[str, Any] | None = None,
+        render_mode: str | None = None,
+        **overrides: Any,
+    ) -> None:
+        if isinstance(config, ExploreConfig):
+            cfg = config.replace(**overrides) if overrides else config
+        else:
+            cfg = ExploreConfig.from_dict(config or {}, **overrides)
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode: must be one of {self.metadata['render_modes']}, got {render_mode!r}"
+            )
+        self.config, self.render_mode = cfg, render_mode
+        self.suite = SensorSuite.from_config(cfg)
+        self.generator = _generator(cfg)
+        n, nz = self.suite.n, cfg.noise
+        self._top = float(self.suite.r_max.max() + 2 * nz.range + 1.0)
+        self._odo_top = np.array(
+            [[10 * cfg.max_speed + 2 * nz.speed + 1.0], [10 * cfg.max_yaw_rate + 2 * nz.yaw_rate + 1.0]]
+        )
+        self.action_space = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
+        self.observation_space = spaces.Dict(
+            {
+                "ranges": spaces.Box(0.0, self._top, shape=(n, 2), dtype=np.float64),
+                "no_echo": spaces.MultiBinary(n),
+                "odometry": spaces.Box(
+                    -np.repeat(self._odo_top, 2, 1), np.repeat(self._odo_top, 2, 1), dtype=np.float64
+                ),
+                "heading": spaces.Box(
+                    -math.pi - 1.0 - 2 * nz.heading,
+                    math.pi + 1.0 + 2 * nz.heading,
+                    shape=(2,),
+                    dtype=np.float64,
+                ),
+            }
+        )
+        self._odo_tops = (float(self._odo_top[0, 0]), float(self._odo_top[1, 0]))
+        hb = self.observation_space["heading"]
+        self._heading_box = (float(hb.low[0]), float(hb.high[0]))
+        self.world: World | None = None
+        self.sim: RobotSim | None = None
+        self.coverage: Coverage | None = None
+        self._renderer: Any = None
+
+    # --- gymnasium API -------------------------------------------------------------------------------------
+    def reset(
+        self,
+        *,
+        seed: int | None = None,
+        options: dict[str, Any] | None = None,
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        super().reset(seed=seed)
+        cfg = self.config
+        if seed is not None or self.world is None or not cfg.fixed_world:
+            self.world = self.generator.generate(int(self.np_random.integers(2**31 - 1)))
+        heading = float(self.np_random.uniform(-math.pi, math.pi))
+        skin = 1.5 * cfg.max_speed * cfg.dt / cfg.substeps
+        if cfg.start is not None:
+            pose = np.asarray(cfg.start, dtype=np.float64)
+            self.world.check_start(pose, cfg.robot_radius + skin)
+        elif self.world.clearance(np.zeros((1, 2)))[0] >= 1.5 * cfg.robot_radius + skin:
+            pose = np.array([0.0, 0.0, heading])
+        else:
+            pose = self.world.sample_free_pose(self.np_random, 1.5 * cfg.robot_radius + skin)
+        self.sim = RobotSim(self.world, cfg.robot_radius, pose, cfg.max_force, cfg.max_torque, skin)
+        self.coverage = Coverage(self.world, cfg.coverage_resolution, float(self.suite.r_max.max()))
+        self.t, self.path = 0.0, [pose[:2].copy()]
+        record, truth = self._sense(0)
+        self.coverage.update(truth.pose, self.suite, truth.ranges)
+        self._last = record
+        return self._obs(record), self._info(record, truth)
+
+    def step(self, action: np.ndarray) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        return self._step(action)
+
+    def _step(
+        self, action: np.ndarray, observe: bool = True
+    ) -> tuple[dict[str, np.ndarray] | None, float, bool, bool, dict[str, Any]]:
+        """:meth:`step`; with ``observe=False`` the raw observation is not built and None stands in its place
+        (the internal fast path of the observer wrapper, which hands the agent its own observation)."""
+        if self.sim is None:
+            raise RuntimeError("step: call reset() before step()")
+        a = self._check_action(action)
+        cfg = self.config
+        t1 = self.t + cfg.dt
+        bumps = self.sim.step(a[0] * cfg.max_speed, a[1] * cfg.max_yaw_rate, exact_duration(self.t, t1),
+                              cfg.substeps)  # fmt: skip
+        self.t = t1
+        record, truth = self._sense(bumps)
+        self.path.append(truth.pose[:2].copy())
+        self._last = record
+        reward = self._reward(truth)
+        if self.render_mode == "human":
+            self.render()
+        obs = self._obs(record) if observe else None
+        return obs, reward, self._terminated(), False, self._info(record, truth)
+
+    def render(self) -> np.ndarray | None:
+        if self.render_mode is None:
+            gym.logger.warn("render: no render_mode was given at construction")
+            return None
+        if self._renderer is None:
+            from digslam.envs.world.render import Renderer
+
+            self._renderer = Renderer(self.render_mode, self.metadata["render_fps"])
+        return self._renderer.draw(self)
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    def measure_coverage_on(self, coverage: Coverage) -> None:
+        """Measure the ground-truth coverage (the reward, ``info["coverage"]`` and termination) on
+        ``coverage``'s cells until the next reset, instead of the world's whole free raster.
+
+        The certified-coverage wrapper passes the reachable free cells of its grid (already updated with
+        the reset's readings), so that one compiled update a step serves both the raw env and the wrapper's
+        ``true_coverage``, and both speak of the same area as the certified coverage."""
+        if self.sim is None:
+            raise RuntimeError("measure_coverage_on: call reset() first")
+        self.coverage = coverage
+
+    # --- pieces of step ------------------------------------------------------------------------------------
+    def _check_action(self, action: np.ndarray) -> tuple[float, float]:
+        a = np.asarray(action)
+        if a.shape != (2,):
+            raise ValueError(f"action: expected shape (2,), got {a.shape}")
+        v, w = float(a[0]), float(a[1])
+        if not (math.isfinite(v) and math.isfinite(w)):
+            raise ValueError(f"action: must be finite, got {[v, w]}")
+        if abs(v) > 1.0 + 1e-6 or abs(w) > 1.0 + 1e-6:
+            raise ValueError(f"action: must lie in [-1, 1]^2 (normalised v, omega), got {[v, w]}")
+        return min(max(v, -1.0), 1.0), min(max(w, -1.0), 1.0)
+
+    def _sense(self, bumps: int) -> tuple[MissionRecord, GroundTruth]:
+        assert self.sim is not None and self.world is not None
+        sim = self.sim
+        pose = sim.pose
+        ranges = self.suite.true_ranges(self.world, pose)
+        bounds = self.suite.range_bounds(self.world, pose, sim.pose_error)
+        record = measure_step(self.t, self.suite, bounds, sim.speed_hull, sim.yaw_hull, pose[2],
+                              self.config.noise, self.np_random)  # fmt: skip
+        truth = GroundTruth.of_step(self.t, pose, sim.speed, sim.yaw_rate, ranges, bumps, sim.bumps,
+                                    sim.pieces.copy(), sim.pose_error)  # fmt: skip
+        return record, truth
+
+    def _reward(self, truth: GroundTruth) -> float:
+        assert self.coverage is not None
+        return self.coverage.update(truth.pose, self.suite, truth.ranges)
+
+    def _terminated(self) -> bool:
+        assert self.coverage is not None
+        return self.coverage.fraction >= 1.0
+
+    def _info(self, record: MissionRecord, truth: GroundTruth) -> dict[str, Any]:
+        assert self.coverage is not None
+        return {
+            "record": record,
+            "truth": truth,
+            "coverage": self.coverage.fraction,
+            "bumps": int(truth.bumps_total),
+        }
+
+    def _obs(self, record: MissionRecord) -> dict[str, np.ndarray]:
+        # lower range bounds are >= 0 by construction; the heading is shifted by a multiple of 2 pi
+        lo, hi = self._heading_box
+        ranges, no_echo, odo, heading = obs_kernel(record.range, record.no_echo, record.speed,
+                                                   record.yaw_rate, record.heading, self._top,
+                                                   self._odo_tops[0], self._odo_tops[1], lo, hi)  # fmt: skip
+        return {"ranges": ranges, "no_echo": no_echo, "odometry": odo, "heading": heading}
+
+
+__all__ = [
+    "ExploreEnv",
+]

@@ -1,0 +1,194 @@
+"""Compiled kernel of the ground-truth coverage (:mod:`.coverage`: the reward of ``digslam/Explore-v0``, and
+the ground truth the certified coverage is compared with, over the reachable free area).
+
+The sensed radius is a step function of the world bearing: on each angular interval between cone edges,
+the largest reach of the cones covering it. :func:`cover_kernel` turns the interval bounds into world
+bearings, orders them by :func:`pseudo_angle` (a monotone stand-in for ``atan2``) and marks every free,
+not yet seen cell of the window whose centre lies strictly closer than the radius of its bearing's interval
+(bearings before the first bound fall in the last interval, which wraps around). Cells nearer than the
+smallest radius are marked first; then each interval of a larger radius scans the bounding box of its
+sector only, and decides each cell there through a lookup table of pseudo-angle bins (a binary search in
+the bins that hold a bound), keeping the cells whose interval it is. Same decisions as the numpy version it
+replaced (the test oracle of ``tests/test_sim_jit.py``), except for cell centres within rounding of a cone
+edge.
+
+Example (one omnidirectional sensor of reach 0.12 at the centre of a 3 x 3 grid of 0.1 m cells):
+    >>> import numpy as np
+    >>> free, seen = np.ones((3, 3), dtype=bool), np.zeros((3, 3), dtype=bool)
+    >>> xs = ys = np.array([0.05, 0.15, 0.25])
+    >>> cover_kernel(free, seen, xs, ys, 0, 3, 0, 3, 0.15, 0.15, 0.0, np.array([0.0]),
+    ...              np.ones((1, 1), dtype=bool), np.array([np.inf]), np.array([0.12]))
+    5
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from digslam.observer.core.scalar_jit import njit
+
+#: Bins of the per-step radius lookup table over pseudo-angles ``[0, 4)``.
+NB = 256
+
+
+@njit(inline="always")
+def pseudo_angle(x: float, y: float) -> float:
+    """A strictly increasing function of the bearing of ``(x, y)`` in ``[0, 2 pi)``, with values in ``[0, 4)``
+    (the "diamond angle": one division, no libm call; 0 at the origin)."""
+    if x == 0.0 and y == 0.0:
+        return 0.0
+    if y >= 0.0:
+        return y / (x + y) if x >= 0.0 else 1.0 - x / (y - x)
+    return 2.0 - y / (-x - y) if x < 0.0 else 3.0 + x / (x - y)
+
+
+@njit
+def cover_kernel(free: np.ndarray, seen: np.ndarray, xs: np.ndarray, ys: np.ndarray, i0: int, i1: int,
+                 j0: int, j1: int, x: float, y: float, th: float, breaks: np.ndarray, cover: np.ndarray,
+                 ranges: np.ndarray, r_max: np.ndarray) -> int:  # fmt: skip
+    """Mark the cells ``[i0:i1, j0:j1]`` sensed from ``(x, y, th)`` in ``seen``; return how many are new.
+
+    Args:
+        free, seen: Boolean rasters ``(ny, nx)``; ``seen`` is updated in place.
+        xs, ys: Cell-centre coordinates.
+        i0, i1, j0, j1: The window of rows and columns.
+        x, y, th: Sensor pose.
+        breaks: Cone-edge bearings in the robot frame, in ``[0, 2 pi)``, sorted, starting at 0, ``(B,)``.
+        cover: ``(B, n)``: which sensors cover the interval that starts at each break.
+        ranges: True range per sensor ``(n,)`` (``inf`` without echo).
+        r_max: Maximum ranges ``(n,)``; a sensor senses up to ``min(range, r_max)``.
+    """
+    B, n = cover.shape
+    two_pi = 2 * np.pi
+    world, rad, wrad = np.empty(B), np.zeros(B), np.empty(B)
+    for b in range(B):
+        wrad[b] = np.mod(breaks[b] + th, two_pi)
+        world[b] = pseudo_angle(math.cos(wrad[b]), math.sin(wrad[b]))
+        r = 0.0
+        for s in range(n):
+            if cover[b, s]:
+                r = max(r, ranges[s] if ranges[s] < r_max[s] else r_max[s])
+        rad[b] = r
+    order = np.arange(B)  # stable insertion sort by pseudo-angle (B is small)
+    for b in range(1, B):
+        o, q = order[b], b
+        while q > 0 and world[order[q - 1]] > world[o]:
+            order[q] = order[q - 1]
+            q -= 1
+        order[q] = o
+    ws, r2, wr = world[order], rad[order] * rad[order], wrad[order]
+    r2min = r2.min()
+    # Lookup table of the interval index over NB bins of pseudo-angle [q / 64, (q + 1) / 64]: exact where
+    # no bound lies in a bin (the interval is the same for every bearing in it), -2 (search) where one does.
+    tab = np.empty(NB, dtype=np.int64)
+    c = 0
+    while c < B and ws[c] <= 0.0:
+        c += 1
+    c_lo = c
+    for q in range(NB):
+        hi = (q + 1) / 64.0
+        while c < B and ws[c] <= hi:
+            c += 1
+        tab[q] = (c_lo - 1 if c_lo > 0 else B - 1) if c == c_lo else -2  # c_lo = #(ws <= q / 64)
+        c_lo = c
+    resx = (xs[xs.shape[0] - 1] - xs[0]) / (xs.shape[0] - 1) if xs.shape[0] > 1 else math.inf  # one column:
+    resy = (ys[ys.shape[0] - 1] - ys[0]) / (ys.shape[0] - 1) if ys.shape[0] > 1 else math.inf  # no cut needed
+    w = (free, seen, xs, ys, i0, i1, j0, j1, x, y, resx, resy)
+    # Cells nearer than the smallest radius are sensed whatever their bearing.
+    rm = math.sqrt(r2min)
+    count = _scan(w, -rm, rm, -rm, rm, r2min, -1, r2min, ws, tab, B)
+    # Then each interval of a larger radius, over the bounding box of its sector (cells of other intervals
+    # in the box are left to their own interval).
+    for b in range(B):
+        if r2[b] <= r2min:
+            continue
+        R = math.sqrt(r2[b])
+        a0, a1 = wr[b], (wr[b + 1] if b + 1 < B else wr[0] + two_pi)
+        xlo, xhi = min(0.0, R * math.cos(a0), R * math.cos(a1)), max(0.0, R * math.cos(a0), R * math.cos(a1))
+        ylo, yhi = min(0.0, R * math.sin(a0), R * math.sin(a1)), max(0.0, R * math.sin(a0), R * math.sin(a1))
+        for q in range(9):  # the axis directions q pi / 2 inside the sector
+            if a0 - 1e-9 <= q * (0.5 * np.pi) <= a1 + 1e-9:
+                m = q % 4
+                if m == 0:
+                    xhi = max(xhi, R)
+                elif m == 1:
+                    yhi = max(yhi, R)
+                elif m == 2:
+                    xlo = min(xlo, -R)
+                else:
+                    ylo = min(ylo, -R)
+        count += _scan(w, xlo, xhi, ylo, yhi, r2[b], b, r2min, ws, tab, B)
+    return count
+
+
+@njit
+def _scan(w: tuple, xlo: float, xhi: float, ylo: float, yhi: float, r2b: float, b: int, r2min: float,
+          ws: np.ndarray, tab: np.ndarray, B: int) -> int:  # fmt: skip
+    """Mark the free, unseen cells of the box ``[xlo, xhi] x [ylo, yhi]`` (relative to the pose, widened by
+    two cells) closer than ``sqrt(r2b)``: all of them if ``b < 0``, else those of bearing interval ``b``
+    beyond ``sqrt(r2min)``."""
+    free, seen, xs, ys, i0, i1, j0, j1, x, y, resx, resy = w
+    ia = max(i0, int(math.floor((y + ylo - ys[0]) / resy)) - 2)
+    ib = min(i1, int(math.floor((y + yhi - ys[0]) / resy)) + 3)
+    ja = max(j0, int(math.floor((x + xlo - xs[0]) / resx)) - 2)
+    jb = min(j1, int(math.floor((x + xhi - xs[0]) / resx)) + 3)
+    count = 0
+    for i in range(ia, ib):
+        vy = ys[i] - y
+        for j in range(ja, jb):
+            if not free[i, j] or seen[i, j]:
+                continue
+            vx = xs[j] - x
+            d2 = vx * vx + vy * vy
+            if not d2 < r2b:
+                continue
+            if b >= 0:
+                if d2 < r2min:
+                    continue
+                p = pseudo_angle(vx, vy)
+                k = tab[min(int(p * 64.0), NB - 1)]
+                if k == -2:  # binary search: k = #(ws <= p) - 1
+                    lo, hi = 0, B
+                    while lo < hi:
+                        mid = (lo + hi) // 2
+                        if ws[mid] <= p:
+                            lo = mid + 1
+                        else:
+                            hi = mid
+                    k = lo - 1 if lo > 0 else B - 1  # before the first bound: the last interval
+                if k != b:
+                    continue
+            seen[i, j] = True
+            count += 1
+    return count
+
+
+@njit
+def cover_update(free: np.ndarray, seen: np.ndarray, xs: np.ndarray, ys: np.ndarray, win: np.ndarray,
+                 pose: np.ndarray, breaks: np.ndarray, cover: np.ndarray, ranges: np.ndarray,
+                 r_max: np.ndarray) -> int:  # fmt: skip
+    """:func:`cover_kernel` on the window of cells within reach of ``pose`` ``(x, y, theta)``: ``win`` is
+    ``(x0, y0, dx, dy, kx, ky)``, the grid's lower-left corner, its cell sides and the reach in cells; the
+    window is the ``(2 ky + 1) x (2 kx + 1)`` cells around the pose's cell (one call per step, no Python
+    arithmetic), narrowed to this step's farthest reading: no cell centre beyond ``max_s min(range_s,
+    r_max_s)`` can be marked."""
+    x, y, th = pose[0], pose[1], pose[2]
+    ny, nx = free.shape
+    far = 0.0
+    for s in range(ranges.shape[0]):
+        far = max(far, min(ranges[s], r_max[s]))
+    kx = min(int(win[4]), int(math.ceil(far / win[2])) + 1)
+    ky = min(int(win[5]), int(math.ceil(far / win[3])) + 1)
+    ic, jc = int(math.floor((y - win[1]) / win[3])), int(math.floor((x - win[0]) / win[2]))
+    i0, i1, j0, j1 = max(ic - ky, 0), min(ic + ky + 1, ny), max(jc - kx, 0), min(jc + kx + 1, nx)
+    return cover_kernel(free, seen, xs, ys, i0, i1, j0, j1, x, y, th, breaks, cover, ranges, r_max)
+
+
+__all__ = [
+    "NB",
+    "cover_kernel",
+    "cover_update",
+    "pseudo_angle",
+]

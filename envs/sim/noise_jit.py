@@ -1,0 +1,150 @@
+"""Compiled kernels of the bounded noise (:mod:`.noise`) and of the step's record (:mod:`.sensors`).
+
+The random draws stay in numpy (``rng.uniform``, in the same order as before, so runs are reproducible);
+the kernels turn them into measured values and intervals. Every interval contains the truth exactly:
+
+* ``uniform`` / ``biased``: ``[m - b, m + b]`` widened by 4 ulps of ``max(|m|, b)``;
+* ``adversarial``: the truth is one bound, the other is ``truth ± 2 b`` widened by 4 ulps of
+  ``max(|truth|, 2 b)``.
+
+``4 * np.spacing(s)`` for ``s >= 0`` is computed as ``4 * (nextafter(s, inf) - s)``, the same value.
+
+Example (adversarial noise: the truth is a bound):
+    >>> import numpy as np
+    >>> m, lo, hi = np.empty(2), np.empty(2), np.empty(2)
+    >>> noise_kernel(np.array([1.0, 2.0]), np.array([0.1, 0.1]), np.array([0.5, -0.5]), ADVERSARIAL, 0.0,
+    ...              m, lo, hi)
+    >>> bool(lo[0] == 1.0 and hi[1] == 2.0 and hi[0] > 1.2 and lo[1] < 1.8)
+    True
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from digslam.observer.core.scalar_jit import njit
+
+UNIFORM, ADVERSARIAL, BIASED = 0, 1, 2
+#: Noise model name to kernel code.
+MODEL_CODES = {"uniform": UNIFORM, "adversarial": ADVERSARIAL, "biased": BIASED}
+
+
+@njit(inline="always")
+def _pad4(s: float) -> float:
+    """``4 * np.spacing(s)`` for ``s >= 0``."""
+    return 4.0 * (np.nextafter(s, math.inf) - s)
+
+
+@njit(inline="always")
+def _one(t: float, b: float, u: float, model: int, bias: float) -> tuple[float, float, float]:
+    """``(measured, lo, hi)`` of one truth ``t`` with bound ``b`` from the uniform draw ``u in [-1, 1)``."""
+    if model == ADVERSARIAL:
+        side = 1.0 if u >= 0 else -1.0
+        far = t + side * 2.0 * b
+        pad = _pad4(max(abs(t), 2.0 * b))
+        if side > 0:
+            return t + side * b, t, far + pad
+        return t + side * b, far - pad, t
+    e = (bias + (1.0 - abs(bias)) * u) * b if model == BIASED else u * b
+    m = t + e
+    pad = _pad4(max(abs(m), b))
+    return m, (m - b) - pad, (m + b) + pad
+
+
+@njit
+def noise_kernel(truth: np.ndarray, bound: np.ndarray, u: np.ndarray, model: int, bias: float,
+                 m: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> None:  # fmt: skip
+    """Measured values and intervals of flat arrays, written into ``m``, ``lo``, ``hi``."""
+    for i in range(truth.shape[0]):
+        m[i], lo[i], hi[i] = _one(truth[i], bound[i], u[i], model, bias)
+
+
+@njit(inline="always")
+def _pad(v: float, tol: float, sign: float) -> float:
+    """``v + sign * tol * max(1, |v|)`` (``|v|`` taken as 0 when infinite), the simulator's widening."""
+    a = abs(v) if math.isfinite(v) else 0.0
+    return v + sign * (tol * max(1.0, a))
+
+
+@njit
+def record_kernel(r_b: np.ndarray, r_max: np.ndarray, s_lo: float, s_hi: float,
+                  w_lo: float, w_hi: float, heading: float, b_speed: float, b_yaw: float, b_heading: float,
+                  b_range: float, u: np.ndarray, model: int, bias: float, flag: np.ndarray, o_lo: np.ndarray,
+                  o_hi: np.ndarray, tol: float, out: np.ndarray, no_echo: np.ndarray) -> int:  # fmt: skip
+    """Intervals of one step into ``out (n + 3, 2)`` (speed, yaw rate, heading, then ranges); ``no_echo``.
+
+    ``s_lo, s_hi, w_lo, w_hi`` are the speed and yaw-rate hulls and ``heading`` the true heading;
+    ``r_b (n, 2)`` bounds each true sector distance (``[r, r]`` where it is known exactly; ``inf`` where
+    nothing lies in the sector); ``b_*`` the noise bounds; ``u`` the ``n + 3`` uniform draws;
+    ``flag, o_lo, o_hi`` the outliers replacing range readings. A hull ``[lo, hi]`` is reported as the noisy
+    interval of its midpoint widened by its half-width, so it contains the whole hull (under
+    ``adversarial`` noise the hull touches a bound). A reading is ``no_echo`` (``[r_max, inf]``) only when
+    the lower bound exceeds ``r_max``; one whose upper bound is not finite reads ``[min(lo, r_max), inf]``.
+    ``tol`` widens every finite bound by ``tol * max(1, |bound|)`` (0 when the truths are rigorous).
+    Returns the first row whose interval has a NaN or ``lo > hi`` (the checks of
+    :class:`~digslam.observer.slam.record.MissionRecord`), -1 if none.
+    """
+    n = r_b.shape[0]
+    for k in range(2):
+        h_lo, h_hi, b = (s_lo, s_hi, b_speed) if k == 0 else (w_lo, w_hi, b_yaw)
+        half = 0.5 * (h_hi - h_lo)
+        _, lo, hi = _one(0.5 * (h_lo + h_hi), b, u[k], model, bias)
+        out[k, 0], out[k, 1] = min(lo - half, h_lo), max(hi + half, h_hi)  # exact containment of the hull
+    _, out[2, 0], out[2, 1] = _one(heading, b_heading, u[2], model, bias)
+    for s in range(n):
+        a, z = r_b[s, 0], r_b[s, 1]
+        no_echo[s] = not a <= r_max[s]
+        if no_echo[s] or not math.isfinite(z):
+            _, lo, hi = _one(0.0 if no_echo[s] else a, b_range, u[3 + s], model, bias)
+            lo, hi = min(lo, r_max[s]), math.inf
+        else:
+            half = 0.5 * (z - a)
+            _, lo, hi = _one(0.5 * (a + z), b_range, u[3 + s], model, bias)
+            lo, hi = min(lo - half, a), max(hi + half, z)
+        if flag[s]:
+            out[3 + s, 0], out[3 + s, 1] = o_lo[s], o_hi[s]
+            no_echo[s] = False
+        elif no_echo[s]:
+            out[3 + s, 0], out[3 + s, 1] = r_max[s], math.inf
+        else:
+            out[3 + s, 0], out[3 + s, 1] = max(lo, 0.0), hi
+    bad = -1
+    for k in range(n + 3):
+        if tol > 0:
+            out[k, 0], out[k, 1] = _pad(out[k, 0], tol, -1.0), _pad(out[k, 1], tol, 1.0)
+        if bad < 0 and not out[k, 0] <= out[k, 1]:
+            bad = k
+    return bad
+
+
+@njit
+def obs_kernel(rng: np.ndarray, no_echo: np.ndarray, speed: np.ndarray, yaw: np.ndarray, heading: np.ndarray,
+               top: float, s_top: float, w_top: float, h_lo: float,
+               h_hi: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """The observation of a record: ranges capped at ``top``, ``no_echo`` as int8, the odometry ``(2, 2)``
+    clipped to ``±s_top`` and ``±w_top``, and the heading shifted by the multiple of ``2 pi`` nearest its
+    midpoint (half to even, as ``np.round``), clipped to ``[h_lo, h_hi]``; all new arrays."""
+    n = rng.shape[0]
+    r, e = np.empty((n, 2)), np.empty(n, dtype=np.int8)
+    for s in range(n):
+        r[s, 0], r[s, 1] = min(rng[s, 0], top), min(rng[s, 1], top)
+        e[s] = 1 if no_echo[s] else 0
+    odo = np.empty((2, 2))
+    for j in range(2):
+        odo[0, j] = min(max(speed[j], -s_top), s_top)
+        odo[1, j] = min(max(yaw[j], -w_top), w_top)
+    k = np.rint(0.5 * (heading[0] + heading[1]) / (2 * math.pi)) * 2 * math.pi
+    h = np.empty(2)
+    for j in range(2):
+        h[j] = min(max(heading[j] - k, h_lo), h_hi)
+    return r, e, odo, h
+
+
+__all__ = [
+    "MODEL_CODES",
+    "noise_kernel",
+    "obs_kernel",
+    "record_kernel",
+]

@@ -1,0 +1,296 @@
+"""Online guaranteed Dig-SLAM: Algorithm 6.3 (thesis §6.4, Eq. 6.21–6.23) run as a filter, one step at a time.
+
+Each :meth:`OnlineDigSlam.update` takes the next single-step record and
+
+1. predicts ``ψ_k ∈ [ψ_{k-1}] + [dt]·[ω_k]`` (intersected with the compass) and the heading over the
+   slice, then ``x_k ∈ x_{k-1} + [dt]·[v_k] (cos, sin)([ψ] on the slice)`` (Eq. 6.23; record ``k``'s speed
+   and yaw rate bound the truth over the slice ``[t_{k-1}, t_k]`` that ends at it: the data contract of
+   :mod:`digslam.observer.slam.record`); compiled scalar outward rounding (:func:`.online_jit_pose.predict`),
+   each correctly rounded operation stepped one ulp outward, ``cos``/``sin`` widened by more than
+   :data:`~.rounding.LIBM_ULPS`;
+2. contracts the box with the impacts ``dist(x_k, comp M⁻) <= y⁺`` (Eq. 6.22) on a window
+   (:func:`.online_jit_pose.contract`);
+3. digs ``M⁻ := M⁻ ∪ g⁻¹_{[x_k]}(Z⁻)`` (Eq. 6.21) and grows the explored zone: certainly sensed =
+   dug, possibly sensed = not proved outside every sensed sector, one compiled pass over the cells in
+   sensor reach (:func:`.online_jit_mark.dig_and_mark`);
+4. optionally (``smoothing_window = W``) contracts the last ``W`` boxes backward,
+   ``x_j &= x_{j+1} - [d_j]``, and digs again the readings of the boxes that shrank.
+
+Steps 1–3 run as one compiled call (:func:`.online_jit_step.filter_step`, the same kernels chained), and
+:attr:`OnlineDigSlam.touched` grows by the smallest window holding the cells the step changed.
+
+State is a fixed set of arrays (plus a ring of ``W`` steps): memory does not grow with the episode.
+An empty box means the data contradict their bounds: the filter says so and stops, and withdraws its claims.
+
+**What is claimed, and when** (``q = 0``). If every interval of the records contains the truth, the true
+position lies in the box, every dug cell is free and every cell coded clear / dark was / was not sensed.
+If some reading misses the truth, the filter detects it only when the box becomes empty, which may happen
+later or never: until then that reading's claims stand, and one false long echo (or a range shifted up)
+digs false free space at once. The filter never reads the record's ``outlier`` flag.
+
+**q-relaxed mode** (``OnlineConfig(q=q)``, thesis §2.6.2, the relaxed intersection of Eq. 2.54). The premise
+becomes: *at most* ``q`` *of the range readings of each step* (per step, not per window of steps: the
+readings of different steps may hold ``q`` outliers each) miss the truth; the odometry, the compass and
+``X₀`` still hold. Then, for every step,
+
+* a cell is dug (``M⁻``) and certainly sensed (clear) only where at least ``q + 1`` readings of the step
+  prove it free (per cell and step: counted in one pass, then dug where the count reaches ``q + 1``); one
+  of them is an inlier, so the claim holds. With ``q >=`` the number of readings nothing is ever dug;
+* the impact contraction (Eq. 6.22) keeps the positions consistent with all but at most ``q`` echoes,
+  the hull of the q-relaxed intersection: ``dist(x, comp M⁻) <=`` the ``(q + 1)``-th smallest ``y⁺``
+  (:func:`.online_jit_pose.impact_bound_q`);
+* the possibly sensed zone grows with the maximum range ``r_max`` of every reading (an outlier's ``y⁺``
+  may be below the truth), so no dark cell was sensed.
+
+So up to ``q`` bad readings per step make no false claim at all. With more, the guarantee is that of
+``q = 0`` with bad data: an empty box is still reported (the filter stops and withdraws its claims), but
+claims made before that may be false. ``q = 0`` runs exactly the former kernels (bit for bit, same speed).
+
+>>> from digslam.observer.slam.record import MissionRecord
+>>> def step(k):
+...     return MissionRecord(t=0.1 * k, speed=[0.99, 1.01], yaw_rate=[-0.01, 0.01], heading=[-1e-3, 1e-3],
+...         alpha=[0.0], gamma=[np.pi], r_max=[5.0], range=[[1.99 - 0.1 * k, 2.01 - 0.1 * k]],
+...         no_echo=[False], outlier=[False])                                     # a wall at x = 2
+>>> f = OnlineDigSlam(Grid((-3.0, -3.0), (3.0, 3.0), (60, 60)))
+>>> f.reset([0.0, 0.0], [0.0, 0.0], step(0))
+>>> for k in range(1, 6):
+...     f.update(step(k))
+>>> f.consistent, f.steps, bool(f.pose_lo[0] <= 0.5 <= f.pose_hi[0]), bool(f.dig.free[30, 52])
+(True, 6, True, False)
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import deque
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from digslam.observer.core import rounding as rnd
+from digslam.observer.online.mark_jit import dig_and_mark_q
+from digslam.observer.online.pose_jit import cos_sin as _cos_sin  # noqa: F401  (re-exported: the tests use it)
+from digslam.observer.online.pose_jit import impact_bound_q
+from digslam.observer.online.step_jit import filter_step_q
+from digslam.observer.online.window import WindowDigMap
+from digslam.observer.slam.grid import Grid
+from digslam.observer.slam.record import MissionRecord
+from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+
+__all__ = ["OnlineConfig", "OnlineDigSlam"]
+
+_INF = math.inf
+
+
+@dataclass(frozen=True)
+class OnlineConfig:
+    """Settings of :class:`OnlineDigSlam`.
+
+    Attributes:
+        smoothing_window: fixed-lag backward smoothing over the last ``W`` steps (0 = off).
+        impacts: apply the impact contractor (Eq. 6.22).
+        q: the q-relaxed mode (thesis §2.6.2): at most ``q`` of the range readings of ONE step are outliers
+            (their intervals may miss the truth; which ones is unknown). 0 (default): none, every claim as
+            in Algorithm 6.3. See the module docstring.
+    """
+
+    smoothing_window: int = 0
+    impacts: bool = True
+    q: int = 0
+
+    def __post_init__(self) -> None:
+        w = self.smoothing_window
+        if not (isinstance(w, int | np.integer) and not isinstance(w, bool) and w >= 0):
+            raise ValueError(f"smoothing_window: must be an integer >= 0, got {w!r}")
+        if not isinstance(self.impacts, bool | np.bool_):
+            raise ValueError(f"impacts: must be a bool, got {self.impacts!r}")
+        if not (isinstance(self.q, int | np.integer) and not isinstance(self.q, bool) and self.q >= 0):
+            raise ValueError(f"q: must be an integer >= 0 (outliers allowed per step), got {self.q!r}")
+
+    @classmethod
+    def from_dict(cls, data: Any) -> OnlineConfig:
+        """Build from a mapping; an unknown key raises ``ValueError`` naming it."""
+        unknown = sorted(set(data) - set(cls.__dataclass_fields__))
+        if unknown:
+            known = sorted(cls.__dataclass_fields__)
+            raise ValueError(f"OnlineConfig: unknown key(s) {unknown}; known: {known}")
+        return cls(**dict(data))
+
+
+class OnlineDigSlam:
+    """The online Dig-SLAM filter (see the module docstring).
+
+    Args:
+        grid: the cells of ``M⁻`` and of the explored zone (they must cover what the robot senses).
+        config: :class:`OnlineConfig` (defaults when None).
+
+    Attributes:
+        pose_lo, pose_hi: ``(2,)`` position box at the last step (``[+inf, -inf]`` once inconsistent).
+        heading_lo, heading_hi: heading interval at the last step.
+        dig: the dig zone ``M⁻`` (:class:`~.online_explored.WindowDigMap`; ``dig.free`` bool ``(ny, nx)``).
+        sensed_sure, sensed_maybe: ``(ny, nx)`` bool, certainly / possibly sensed cells.
+        consistent, inconsistent_step: False and the step index (``reset`` is step 0) once the data
+            contradicted their bounds; the sets then carry no guarantee and ``update`` does nothing.
+        steps: steps folded in (``reset`` counts one); last_update_seconds: wall time of the last update.
+        touched: window ``(r0, r1, c0, c1)`` of the cells changed since :meth:`take_touched`.
+    """
+
+    def __init__(self, grid: Grid, config: OnlineConfig | None = None) -> None:
+        if not isinstance(grid, Grid):
+            raise ValueError(f"grid: expected a Grid, got {type(grid).__name__}")
+        if config is not None and not isinstance(config, OnlineConfig):
+            raise ValueError(f"config: expected an OnlineConfig, got {type(config).__name__}")
+        self.grid, self.config = grid, config or OnlineConfig()
+        self._ring: deque = deque(maxlen=self.config.smoothing_window + 1)
+        self._impacts, self._q = bool(self.config.impacts), int(self.config.q)
+        self._blank()
+
+    def _blank(self) -> None:
+        self.pose_lo, self.pose_hi = np.full(2, _INF), np.full(2, -_INF)
+        self.heading_lo, self.heading_hi = _INF, -_INF
+        self.dig = WindowDigMap(self.grid)
+        self.sensed_sure = np.zeros(self.grid.shape, dtype=bool)
+        self.sensed_maybe = np.zeros(self.grid.shape, dtype=bool)
+        # per-cell reading counts and stamps of the q-relaxed mode (zero between steps; unused when q = 0)
+        self._cnt = np.zeros((2, *self.grid.shape) if self._q else (2, 1, 1), dtype=np.int32)
+        self._lst = np.zeros(self.grid.shape[0] * self.grid.shape[1] + 1 if self._q else 1, dtype=np.int32)
+        self.consistent, self.inconsistent_step = False, None
+        self.steps, self.last_update_seconds = 0, 0.0
+        self._prev: MissionRecord | None = None
+        self._ring.clear()
+        self.touched = (0, self.grid.shape[0], 0, self.grid.shape[1])
+
+    def _check_record(self, rec: Any, name: str = "rec") -> MissionRecord:
+        if not isinstance(rec, MissionRecord) or rec.t.ndim != 0:
+            raise ValueError(f"{name}: expected a single-step MissionRecord (scalar t)")
+        prev = self._prev
+        if name == "rec" and prev is not None:
+            if rec.alpha.shape[-1] != prev.alpha.shape[-1]:  # n_sensors
+                n = prev.n_sensors
+                raise ValueError(f"{name}: {rec.n_sensors} sensors, the episode started with {n}")
+            if not float(rec.t) > float(prev.t):
+                raise ValueError(f"{name}: time {float(rec.t)} does not follow {float(prev.t)}")
+        return rec
+
+    def reset(self, x0_lo: Any, x0_hi: Any, first: MissionRecord) -> None:
+        """Start an episode from the box ``X₀`` (Eq. 6.15) and the record at ``t_0``."""
+        lo, hi = np.array(x0_lo, dtype=np.float64).ravel(), np.array(x0_hi, dtype=np.float64).ravel()
+        g = self.grid
+        if lo.shape != (2,) or hi.shape != (2,) or not (np.isfinite(lo).all() and np.isfinite(hi).all()):
+            raise ValueError(f"x0_lo, x0_hi: expected a finite 2-d box, got {x0_lo} and {x0_hi}")
+        if np.any(lo > hi) or np.any(lo < g.lo) or np.any(hi > g.hi):
+            raise ValueError(f"x0_lo, x0_hi: expected lo <= hi inside the grid's frame, got {lo} and {hi}")
+        first = self._check_record(first, "first")
+        self._blank()
+        self.pose_lo, self.pose_hi = lo, hi
+        self.heading_lo, self.heading_hi = float(first.heading[0]), float(first.heading[1])
+        self.consistent = True
+        self._measure(first, None)
+
+    def update(self, rec: MissionRecord) -> None:
+        """Fold in the next single-step record (does nothing once inconsistent)."""
+        if self._prev is None:
+            raise ValueError("rec: call reset() before update()")
+        rec = self._check_record(rec)
+        if not self.consistent:
+            return
+        start = time.perf_counter()
+        d, out = self.dig, np.empty(10)  # out: the new pose box, heading and displacement (fresh arrays)
+        code, r0, r1, c0, c1 = filter_step_q(d.free, self.sensed_sure, self.sensed_maybe, d.xs, d.ys, d.nys,
+                                             d.frame, self.pose_lo, self.pose_hi, self.heading_lo,
+                                             self.heading_hi, out, float(rec.t) - float(self._prev.t),
+                                             rec.yaw_rate, rec.heading, rec.speed, rec.alpha, rec.gamma,
+                                             rec.r_max, rec.range, rec.no_echo, self._impacts, self._q,
+                                             self._cnt, self._lst)  # fmt: skip
+        if code:
+            return self._fail(start)
+        self.pose_lo, self.pose_hi = out[0:2], out[2:4]
+        self.heading_lo, self.heading_hi = float(out[4]), float(out[5])
+        self._touch(r0, r1, c0, c1)
+        if self.config.smoothing_window:
+            psi = (self.heading_lo, self.heading_hi)
+            self._ring.append([rec, self.pose_lo.copy(), self.pose_hi.copy(), psi, out[6:10]])
+        self._prev = rec
+        self.steps += 1
+        if self.config.smoothing_window and not self._smooth():
+            return self._fail(start)
+        self.last_update_seconds = time.perf_counter() - start
+        return None
+
+    # ------------------------------------------------------------------ internals
+    def _impact_bound(self, rec: MissionRecord) -> float:
+        """Radius of the impact constraint (Eq. 6.22): the ``(q + 1)``-th smallest upper range bound over the
+        echoing sensors (the smallest when ``q = 0``; ``inf`` if fewer echoed), :func:`.impact_bound_q`."""
+        return impact_bound_q(rec.no_echo, rec.range, self._q)
+
+    def _fail(self, start: float) -> None:
+        self.consistent, self.inconsistent_step = False, self.steps
+        self.pose_lo, self.pose_hi = np.full(2, _INF), np.full(2, -_INF)
+        self.heading_lo, self.heading_hi = _INF, -_INF
+        self.steps += 1
+        self.last_update_seconds = time.perf_counter() - start
+
+    def _dig(self, rec: MissionRecord, lo: np.ndarray, hi: np.ndarray, psi: tuple[float, float],
+             mark: bool = False) -> None:  # fmt: skip
+        """Eq. 6.21 for the readings of one step (the dug cells are certainly sensed: radius ``<= r_max``;
+        with ``q > 0`` only the cells proved free by ``q + 1`` of them); with ``mark``, grow the possibly
+        sensed zone with the upper ranges (``q > 0``: the maximum ranges), :func:`.dig_and_mark_q`."""
+        d, q = self.dig, self._q
+        r0, r1, c0, c1 = dig_and_mark_q(d.free, self.sensed_sure, self.sensed_maybe, self._cnt, self._lst,
+                                        d.xs, d.ys, d.nys, lo[0], lo[1], hi[0], hi[1], psi[0], psi[1],
+                                        rec.alpha, rec.gamma, rec.r_max, rec.range, mark, q)  # fmt: skip
+        self._touch(r0, r1, c0, c1)
+
+    def _touch(self, r0: int, r1: int, c0: int, c1: int) -> None:
+        """Grow :attr:`touched` to hold the window ``[r0:r1, c0:c1]`` of changed cells."""
+        if r0 < r1 and c0 < c1:
+            t0, t1, u0, u1 = self.touched
+            if t0 >= t1:
+                self.touched = (r0, r1, c0, c1)
+            else:
+                self.touched = (min(t0, r0), max(t1, r1), min(u0, c0), max(u1, c1))
+
+    def _measure(self, rec: MissionRecord, d: np.ndarray | None) -> None:
+        """Dig the readings of the current step and grow the possibly sensed zone; push the step."""
+        psi = (self.heading_lo, self.heading_hi)
+        self._dig(rec, self.pose_lo, self.pose_hi, psi, mark=True)
+        if self.config.smoothing_window:
+            self._ring.append([rec, self.pose_lo.copy(), self.pose_hi.copy(), psi, d])
+        self._prev = rec
+        self.steps += 1
+
+    def _smooth(self) -> bool:
+        """Backward pass ``x_j &= x_{j+1} - [d_j]`` over the ring; digs again the boxes that shrank."""
+        ring = list(self._ring)
+        for j in range(len(ring) - 2, -1, -1):
+            _, lo, hi, psi, _ = ring[j]
+            d = ring[j + 1][4]
+            nlo = np.maximum(lo, rnd.step_down(ring[j + 1][1] - d[2:]))
+            nhi = np.minimum(hi, rnd.step_up(ring[j + 1][2] - d[:2]))
+            if not np.all(nlo <= nhi):
+                return False
+            if np.array_equal(nlo, lo) and np.array_equal(nhi, hi):
+                break
+            ring[j][1], ring[j][2] = nlo, nhi
+            self._dig(ring[j][0], nlo, nhi, psi)
+        return True
+
+    # ------------------------------------------------------------------ outputs
+    def take_touched(self) -> tuple[int, int, int, int]:
+        """Rows ``r0:r1`` and columns ``c0:c1`` holding every cell of ``dig.free``, ``sensed_sure`` and
+        ``sensed_maybe`` changed since the last call (the whole grid after ``reset``); then clears it."""
+        out, self.touched = self.touched, (0, 0, 0, 0)
+        return out
+
+    def explored(self) -> np.ndarray:
+        """``(ny, nx)`` int8: CLEAR (certainly sensed), PENUMBRA (possibly), DARK (certainly not)."""
+        out = np.full(self.grid.shape, DARK, dtype=np.int8)
+        out[self.sensed_maybe] = PENUMBRA
+        out[self.sensed_sure] = CLEAR
+        return out
+
+    def clear_mask(self) -> np.ndarray:
+        """Certified coverage: proved free and certainly explored."""
+        return self.sensed_sure & self.dig.free

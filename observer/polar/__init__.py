@@ -1,0 +1,38 @@
+"""The polar constraint as contractors and separators (Ch. 4): range-bearing measurements.
+
+Lives here: :mod:`.ctc` (``CtcPolar``, the minimal polar contractor, Sec. 4.3.2, running the kernels of
+:mod:`digslam.observer.core.polar_jit`) and :mod:`.sep` (``SepPolarXY``, ``SepPi``/``SepPiInv`` for sonar
+cones, ``SepLandmark``, Sec. 4.3-4.4).
+
+May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.expr`, :mod:`digslam.observer.sets`; numpy.
+"""
+
+from .ctc import (
+    CtcPolar,
+    CtcPolarNumpy,
+    contract_polar,
+)
+from .sep import (
+    SepCtcPreimage,
+    SepLandmark,
+    SepPi,
+    SepPiInv,
+    SepPolarXY,
+    complement_boxes,
+    project_contract,
+    sep_landmark_fwdbwd,
+)
+
+__all__ = [
+    "CtcPolar",
+    "CtcPolarNumpy",
+    "SepCtcPreimage",
+    "SepLandmark",
+    "SepPi",
+    "SepPiInv",
+    "SepPolarXY",
+    "complement_boxes",
+    "contract_polar",
+    "project_contract",
+    "sep_landmark_fwdbwd",
+]

@@ -1,0 +1,113 @@
+"""Separator for ``f⁻¹(Y)`` by forward-backward propagation (thesis §2.4.4, Theorem 2.1, Eq. 2.62).
+
+One forward pass evaluates ``f`` on the batch; backward passes then project ``Y`` (for ``x_out``)
+and the closed complement of ``Y`` (for ``x_in``) back onto the boxes. ``Y`` is an interval, a box,
+or any separator in the image space. When ``f`` has a :class:`~.jit_tape.Tape` (no trigonometric,
+``min``/``max`` or ``atan2`` node) the whole batch is separated by compiled kernels
+(:mod:`.jit_hc4`); otherwise by the numpy forward-backward of :mod:`.contractors`.
+
+>>> ring = SepInverse(Function(lambda x: (x[0] - 2) ** 2 + (x[1] - 2.5) ** 2), Interval(1, 2.25))
+>>> xin, xout = ring(Box([(3.1, 3.2), (2.4, 2.6)]))        # inside the ring of Ex. 2.7
+>>> bool(xin.is_empty().all()), bool(xout.is_empty().any())
+(True, False)
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from digslam.observer.core.boxes import chunked, empty_rows
+from digslam.observer.core.types import Batch
+from digslam.observer.expr.centred import centred_image
+from digslam.observer.expr.expr import Function
+from digslam.observer.expr.hc4_jit import hc4, image, sep_box
+from digslam.observer.expr.tape_jit import Tape
+from digslam.observer.sets.contractors import forward, hc4_backward
+from digslam.observer.sets.separators import Sep, SepBox, hull_batch, inter_batch
+
+
+class SepInverse(Sep):
+    """Separator of ``{x | f(x) ∈ Y}``.
+
+    Args:
+        f: a :class:`~.expr.Function` ``Rⁿ → Rᵐ`` (or a callable, traced into one).
+        y: an interval or number (``m = 1``), a box of dimension ``m``, or a :class:`Sep` on ``Rᵐ``.
+
+        centred: intersect ``f``'s natural enclosure with its centred (mean-value) form before the
+            backward passes (:mod:`.centred`, Eq. 2.20): fewer bisections near the boundary when
+            variables occur several times; off by default (measured in ``tests/test_centred_form.py``).
+
+    Raises:
+        ValueError: if ``y``'s dimension is not ``m``.
+    """
+
+    def __init__(self, f: Function | Any, y: Any, centred: bool = False) -> None:
+        self.centred = bool(centred)
+        self.f = f if isinstance(f, Function) else Function(f)
+        self.n = self.f.n
+        if isinstance(y, Sep):
+            if y.n is not None and y.n != self.f.m:
+                raise ValueError(f"y: separator of dimension {y.n}, but f has {self.f.m} outputs")
+            self.sep_y, self.box = y, None
+        else:
+            box = SepBox(y)
+            if box.n != self.f.m:
+                raise ValueError(f"y: box of dimension {box.n}, but f has {self.f.m} outputs")
+            self.sep_y, self.box = None, box
+            self._y = np.stack(box.box).astype(np.float64)
+
+    def image(self, vals: list[tuple[np.ndarray, np.ndarray]], n_rows: int) -> Batch:
+        """The forward image ``[f]([x])`` as an ``(N, m)`` batch."""
+        outs = [vals[o] for o in self.f.outputs]
+        ylo = np.stack([np.broadcast_to(o[0], (n_rows,)) for o in outs], axis=1)
+        yhi = np.stack([np.broadcast_to(o[1], (n_rows,)) for o in outs], axis=1)
+        return ylo, yhi
+
+    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        tape = Tape.of(self.f)
+        if tape is None:
+            return chunked(self._separate, lo, hi)
+        if self.box is not None:
+            res = sep_box(tape, lo, hi, self._y, self.centred)
+            return (res[0], res[1]), (res[2], res[3])
+        ylo, yhi = image(tape, lo, hi)
+        if self.centred:
+            ylo, yhi = inter_batch((ylo, yhi), centred_image(self.f, lo, hi))
+        yin, yout = self.sep_y.separate(ylo, yhi)
+        return hc4(tape, lo, hi, *yin, centred=self.centred), hc4(tape, lo, hi, *yout, centred=self.centred)
+
+    def separate_stacked(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        tape = Tape.of(self.f)
+        if tape is not None and self.box is not None:
+            return sep_box(tape, lo, hi, self._y, self.centred)
+        return super().separate_stacked(lo, hi)
+
+    def _separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        vals = forward(self.f, lo, hi, self.centred)
+        if self.box is None:
+            assert self.sep_y is not None
+            yin, yout = self.sep_y.separate(*self.image(vals, lo.shape[0]))
+            return hc4_backward(self.f, vals, yin, lo, hi), hc4_backward(self.f, vals, yout, lo, hi)
+        xout = hc4_backward(self.f, vals, self.box.box, lo, hi)
+        xin = (np.full_like(lo, np.inf), np.full_like(hi, -np.inf))
+        for plo, phi in self.box.pieces(*self.image(vals, lo.shape[0])):
+            live = plo[:, 0] <= phi[:, 0]
+            if live.all():
+                xin = hull_batch(xin, hc4_backward(self.f, vals, (plo, phi), lo, hi))
+            elif live.any():  # project the piece through the rows that meet it only
+                r = np.flatnonzero(live)
+                sub = [(v[0][r], v[1][r]) for v in vals]
+                plo_r, phi_r = hc4_backward(self.f, sub, (plo[r], phi[r]), lo[r], hi[r])
+                xin[0][r] = np.minimum(xin[0][r], plo_r)
+                xin[1][r] = np.maximum(xin[1][r], phi_r)
+        dead = empty_rows(*self.image(vals, lo.shape[0])) & ~empty_rows(lo, hi)
+        if dead.any():  # f defined nowhere on the box: all of it is outside f⁻¹(Y)
+            xin[0][dead], xin[1][dead] = lo[dead], hi[dead]
+        return xin, xout
+
+
+__all__ = [
+    "SepInverse",
+]

@@ -1,0 +1,275 @@
+"""Separators on batches and their algebra (thesis §2.4.2, Eq. 2.46–2.54).
+
+A separator for a set ``X`` maps a batch ``[x]`` to two batches ``([x_in], [x_out])`` with
+``[x_in] ∪ [x_out] = [x]``: ``[x] \\ [x_in]`` is proved inside ``X`` and ``[x] \\ [x_out]`` proved
+outside (``x_in`` keeps the complement, ``x_out`` keeps the set). ``~S`` swaps them (Eq. 2.53),
+``S₁ & S₂`` and ``S₁ | S₂`` follow Eq. 2.54, ``S₁ - S₂ = S₁ & ~S₂``, and :class:`SepQInter` is the
+q-relaxed intersection.
+
+>>> import numpy as np
+>>> s = SepBox(Box([(0, 1), (0, 1)])) & ~SepBox(Box([(0.5, 2), (0.5, 2)]))   # an L shape
+>>> xin, xout = s(Box([(0.6, 0.9), (0.6, 0.9)]))
+>>> bool(xout.is_empty().any()), bool(xin.is_empty().any())                 # proved outside
+(True, False)
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from digslam.observer.core.boxes import empty_rows, normalize_empty, validate_batch
+from digslam.observer.core.interval import IntervalArray, as_pair
+from digslam.observer.core.scalar_jit import njit
+from digslam.observer.core.types import Batch
+
+
+class Sep:
+    """Base class: subclasses implement :meth:`separate` on raw ``(N, n)`` batches."""
+
+    #: input dimension, or None when any dimension goes
+    n: int | None = None
+
+    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        """Return ``((in_lo, in_hi), (out_lo, out_hi))``; inputs are not modified."""
+        raise NotImplementedError(f"{type(self).__name__}.separate")
+
+    def separate_stacked(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        """:meth:`separate` as one ``(4, N, n)`` array ``in_lo, in_hi, out_lo, out_hi`` (what the paver
+        and the algebra pass around; compiled separators produce it directly)."""
+        (ilo, ihi), (olo, ohi) = self.separate(lo, hi)
+        shape = (4, *np.shape(lo))
+        res = np.empty(shape)
+        res[0], res[1], res[2], res[3] = ilo, ihi, olo, ohi
+        return res
+
+    def __call__(self, boxes: IntervalArray | tuple[Any, Any]) -> tuple[Any, Any]:
+        """Separate an :class:`IntervalArray` box ``(n,)`` / batch ``(N, n)``, or a ``(lo, hi)`` pair."""
+        is_ia = isinstance(boxes, IntervalArray)
+        lo, hi = boxes.pair if is_ia else boxes
+        single = np.ndim(lo) == 1
+        lo, hi = validate_batch(lo, hi, "boxes", self.n)
+        res = []
+        for b in self.separate(lo, hi):
+            blo, bhi = normalize_empty(*b)
+            if single:
+                blo, bhi = blo[0], bhi[0]
+            res.append(IntervalArray._raw(blo, bhi) if is_ia else (blo, bhi))
+        return res[0], res[1]
+
+    def __invert__(self) -> Sep:
+        return SepNot(self)
+
+    def __and__(self, other: Sep) -> Sep:
+        return SepInter(self, other)
+
+    def __or__(self, other: Sep) -> Sep:
+        return SepUnion(self, other)
+
+    def __sub__(self, other: Sep) -> Sep:
+        return SepInter(self, SepNot(other))
+
+
+def _dim(seps: tuple[Sep, ...]) -> int | None:
+    dims = {s.n for s in seps if s.n is not None}
+    if len(dims) > 1:
+        raise ValueError(f"separators: mismatched dimensions {sorted(dims)}")
+    return dims.pop() if dims else None
+
+
+def inter_batch(a: Batch, b: Batch) -> Batch:
+    """Row-wise intersection of two batches (empty rows normalised)."""
+    return normalize_empty(np.maximum(a[0], b[0]), np.minimum(a[1], b[1]))
+
+
+def hull_batch(a: Batch, b: Batch) -> Batch:
+    """Row-wise hull of two batches whose empty rows are ``[+inf, -inf]``."""
+    return np.minimum(a[0], b[0]), np.maximum(a[1], b[1])
+
+
+@njit
+def _fold(acc: np.ndarray, s: np.ndarray, lo: np.ndarray, hi: np.ndarray, union: bool) -> np.ndarray:
+    """Fold one separated batch ``s (4, N, n)`` into ``acc`` by Eq. 2.54 (a new ``acc`` when it is
+    ``(0, 0, 0)``): for ``&``, ``x_in ⊔= s_in`` and ``x_out ∩= s_out``; for ``|`` the other way round.
+    The intersections are also met with ``[x]``; empty rows come out as ``[+inf, -inf]``."""
+    nb, n = lo.shape
+    h, m = (2, 0) if union else (0, 2)  # the part taking the hull, the part taking the meet
+    if acc.shape[0] == 0:
+        acc = np.empty((4, nb, n))
+        acc[h], acc[h + 1] = np.inf, -np.inf
+        acc[m], acc[m + 1] = lo, hi
+    for r in range(nb):
+        empty = False
+        for i in range(n):
+            empty |= s[h, r, i] > s[h + 1, r, i]
+        if not empty:
+            for i in range(n):
+                acc[h, r, i] = min(acc[h, r, i], s[h, r, i])
+                acc[h + 1, r, i] = max(acc[h + 1, r, i], s[h + 1, r, i])
+        empty = False
+        for i in range(n):
+            acc[m, r, i] = max(acc[m, r, i], s[m, r, i], lo[r, i])
+            acc[m + 1, r, i] = min(acc[m + 1, r, i], s[m + 1, r, i], hi[r, i])
+            empty |= acc[m, r, i] > acc[m + 1, r, i]
+        if empty:
+            acc[m, r], acc[m + 1, r] = np.inf, -np.inf
+    return acc
+
+
+_NONE = np.empty((0, 0, 0))
+
+
+class _Stacked(Sep):
+    """A separator computed on stacked ``(4, N, n)`` arrays; :meth:`separate` unpacks them."""
+
+    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        res = self.separate_stacked(lo, hi)
+        return (res[0], res[1]), (res[2], res[3])
+
+
+class SepNot(_Stacked):
+    """Complement ``{S_out, S_in}`` (Eq. 2.53)."""
+
+    def __init__(self, sep: Sep) -> None:
+        self.sep, self.n = sep, sep.n
+
+    def separate_stacked(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        return self.sep.separate_stacked(lo, hi)[[2, 3, 0, 1]]
+
+    def __invert__(self) -> Sep:
+        return self.sep
+
+
+class SepInter(_Stacked):
+    """``S₁ ∩ … ∩ S_k = {⊔ S_iⁱⁿ, ∩ S_iᵒᵘᵗ}`` (Eq. 2.54)."""
+
+    union = False
+
+    def __init__(self, *seps: Sep) -> None:
+        self.seps, self.n = seps, _dim(seps)
+
+    def separate_stacked(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        lo, hi = np.ascontiguousarray(lo, dtype=np.float64), np.ascontiguousarray(hi, dtype=np.float64)
+        acc = _NONE
+        for s in self.seps:
+            acc = _fold(acc, np.ascontiguousarray(s.separate_stacked(lo, hi)), lo, hi, self.union)
+        return acc
+
+
+class SepUnion(SepInter):
+    """``S₁ ∪ … ∪ S_k = {∩ S_iⁱⁿ, ⊔ S_iᵒᵘᵗ}`` (Eq. 2.54)."""
+
+    union = True
+
+
+def relaxed_intersection(los: np.ndarray, his: np.ndarray, q: int) -> Batch:
+    """Hull of the points lying in at least ``m - q`` of ``m`` boxes, per coordinate.
+
+    Args:
+        los, his: ``(m, N, n)`` stacks of batches (empty rows ``[+inf, -inf]`` count for nothing).
+        q: number of boxes allowed to miss a point, ``0 <= q < m``.
+
+    Returns:
+        An ``(N, n)`` batch containing the q-relaxed intersection (coordinate-wise, so an outer
+        enclosure of the box relaxed intersection).
+    """
+    m = los.shape[0]
+    need = m - q
+    # a candidate lower bound c = los[j] is valid when #{i : los[i] <= c <= his[i]} >= need
+    inside_lo = (los[None] <= los[:, None]) & (los[:, None] <= his[None])  # (j, i, N, n)
+    cnt_lo = inside_lo.sum(axis=1)
+    lo = np.where(cnt_lo >= need, los, np.inf).min(axis=0)
+    inside_hi = (los[None] <= his[:, None]) & (his[:, None] <= his[None])
+    cnt_hi = inside_hi.sum(axis=1)
+    hi = np.where(cnt_hi >= need, his, -np.inf).max(axis=0)
+    return normalize_empty(lo, hi)
+
+
+class SepQInter(Sep):
+    """q-relaxed intersection of separators (Eq. 2.54): ``{S_iⁱⁿ (m-q-1)-relaxed, S_iᵒᵘᵗ q-relaxed}``.
+
+    The set is the points belonging to at least ``m - q`` of the ``m`` sets: robust to ``q`` outliers.
+    """
+
+    def __init__(self, seps: list[Sep], q: int) -> None:
+        if not seps:
+            raise ValueError("seps: need at least one separator")
+        if not 0 <= q < len(seps):
+            raise ValueError(f"q: must lie in [0, {len(seps)}) for {len(seps)} separators, got {q}")
+        self.seps, self.q, self.n = list(seps), int(q), _dim(tuple(seps))
+
+    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        parts = [s.separate(lo, hi) for s in self.seps]
+        m = len(parts)
+        ilo = np.stack([normalize_empty(*p[0])[0] for p in parts])
+        ihi = np.stack([normalize_empty(*p[0])[1] for p in parts])
+        olo = np.stack([normalize_empty(*p[1])[0] for p in parts])
+        ohi = np.stack([normalize_empty(*p[1])[1] for p in parts])
+        xout = relaxed_intersection(olo, ohi, self.q)
+        xin = relaxed_intersection(ilo, ihi, m - self.q - 1)
+        return inter_batch(xin, (lo, hi)), inter_batch(xout, (lo, hi))
+
+
+class SepBox(Sep):
+    """Separator of a box ``[y]``: ``x_out = [x] ∩ [y]``, ``x_in`` the hull of ``[x]`` minus ``[y]``."""
+
+    def __init__(self, box: Any) -> None:
+        ylo, yhi = as_pair(box, "box")
+        if np.ndim(ylo) == 0:
+            ylo, yhi = ylo[None], yhi[None]
+        if np.ndim(ylo) != 1 or np.any(ylo > yhi):
+            raise ValueError(f"box: expected one non-empty box (n,), got shape {np.shape(ylo)}")
+        self.box, self.n = (ylo, yhi), ylo.shape[0]
+
+    def pieces(self, lo: np.ndarray, hi: np.ndarray) -> list[Batch]:
+        """Boxes enclosing ``[x] ∩ {y_k < a_k}`` and ``[x] ∩ {y_k > b_k}`` for every coordinate ``k``.
+
+        The complement of ``[y] = [a, b]`` is open: each piece is the closed ``[x] ∩ {y_k <= a_k}``
+        (``>= b_k``), except that it is empty when ``x_k⁻ >= a_k`` (``x_k⁺ <= b_k``), for then no point
+        of ``[x]`` lies strictly beyond the bound (a box touching ``[y]`` from inside is not outside).
+        """
+        out = []
+        for k in range(self.n):
+            for side in (0, 1):
+                plo, phi = lo.copy(), hi.copy()
+                if side == 0:
+                    phi[:, k] = np.minimum(hi[:, k], self.box[0][k])
+                    none = lo[:, k] >= self.box[0][k]
+                else:
+                    plo[:, k] = np.maximum(lo[:, k], self.box[1][k])
+                    none = hi[:, k] <= self.box[1][k]
+                plo[none], phi[none] = np.inf, -np.inf
+                out.append(normalize_empty(plo, phi))
+        return out
+
+    def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
+        xout = inter_batch((lo, hi), (self.box[0][None], self.box[1][None]))
+        xin = (np.full_like(lo, np.inf), np.full_like(hi, -np.inf))
+        for p in self.pieces(lo, hi):
+            xin = hull_batch(xin, p)
+        # a box inside [y], even touching its border, has no point outside: its x_in is empty
+        return xin, xout
+
+
+def check_separation(xin: Batch, xout: Batch, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """``(N,)`` mask of rows where ``[x_in] ∪ [x_out]`` fails to be ``[x]`` (hull test; for tests)."""
+    h = hull_batch(normalize_empty(*xin), normalize_empty(*xout))
+    ok = empty_rows(lo, hi) | ((h[0] == lo).all(axis=1) & (h[1] == hi).all(axis=1))
+    sub = ((xin[0] >= lo) & (xin[1] <= hi)).all(axis=1) | empty_rows(*xin)
+    sub &= ((xout[0] >= lo) & (xout[1] <= hi)).all(axis=1) | empty_rows(*xout)
+    return ~(ok & sub)
+
+
+__all__ = [
+    "Sep",
+    "SepBox",
+    "SepInter",
+    "SepNot",
+    "SepQInter",
+    "SepUnion",
+    "check_separation",
+    "hull_batch",
+    "inter_batch",
+    "relaxed_intersection",
+]

@@ -1,0 +1,139 @@
+"""Offline SLAM on a mission record (Ch. 6): from the record to the dig map, the tube and the explored zone.
+
+Lives here: :mod:`.record` (``MissionRecord``, the data contract between a simulator or robot and the
+observers), :mod:`.grid` (the observer's grid), :mod:`.digmap` (``DigMap``, the dig zone M-, Sec. 6.3),
+:mod:`.digslam` (offline Dig-SLAM, Alg. 6.2), :mod:`.explored` and :mod:`.explored_sweep` (the explored zone
+as a thick set, App. B.5), :mod:`.landmarks` (landmark localization, Ex. 3.4), :mod:`.shapes` (sonar
+measurement shapes), :mod:`.shape_registration` and :mod:`.shape_slam` (shape SLAM, Sec. 6.4) and
+:mod:`.explicit_slam` (explicit SLAM, Alg. 6.1).
+
+May import: every folder of :mod:`digslam.observer` except :mod:`~digslam.observer.online`; numpy, scipy.
+"""
+
+from .digmap import (
+    DigMap,
+)
+from .digslam import (
+    DigSlamConfig,
+    DigSlamResult,
+    dig_readings,
+    dig_slam,
+    explored_zone,
+    impact_bound,
+)
+from .explicit_slam import (
+    ExplicitSlamConfig,
+    ExplicitSlamResult,
+    MapFunction,
+    Measurements,
+    RangeMeasurements,
+    RasterShape,
+    SepShapeRegistration,
+    ShapeMeasurements,
+    ThickMap,
+    explicit_slam,
+    mission_tube,
+    shape_carve,
+    shape_register,
+)
+from .explored import (
+    SepExploredDisks,
+    check_interval,
+    check_tube,
+    explored_disks_grid,
+    explored_disks_thick_sep,
+    explored_hypotheses,
+    explored_thick_sep,
+    explored_union,
+)
+from .explored_sweep import (
+    explored_sectors_grid,
+    explored_sweep_grid,
+    sweep_gates,
+)
+from .grid import (
+    Grid,
+)
+from .landmarks import (
+    CtcLandmarks,
+    IterationStats,
+    Localization,
+    contract_detections,
+    contract_disjunctive,
+    localize,
+)
+from .record import (
+    MissionRecord,
+)
+from .shape_registration import (
+    SepTranslationInclusion,
+    ThickImage,
+    level_thick_image,
+    register_translation,
+)
+from .shape_slam import (
+    ShapeSlamConfig,
+    ShapeSlamResult,
+    ctc_minus,
+    overlap_pretest,
+    shape_slam,
+)
+from .shapes import (
+    free_zone,
+    impact_zone,
+    measurement_shapes,
+)
+
+__all__ = [
+    "CtcLandmarks",
+    "DigMap",
+    "DigSlamConfig",
+    "DigSlamResult",
+    "ExplicitSlamConfig",
+    "ExplicitSlamResult",
+    "Grid",
+    "IterationStats",
+    "Localization",
+    "MapFunction",
+    "Measurements",
+    "MissionRecord",
+    "RangeMeasurements",
+    "RasterShape",
+    "SepExploredDisks",
+    "SepShapeRegistration",
+    "SepTranslationInclusion",
+    "ShapeMeasurements",
+    "ShapeSlamConfig",
+    "ShapeSlamResult",
+    "ThickImage",
+    "ThickMap",
+    "check_interval",
+    "check_tube",
+    "contract_detections",
+    "contract_disjunctive",
+    "ctc_minus",
+    "dig_readings",
+    "dig_slam",
+    "explicit_slam",
+    "explored_disks_grid",
+    "explored_disks_thick_sep",
+    "explored_hypotheses",
+    "explored_sectors_grid",
+    "explored_sweep_grid",
+    "explored_thick_sep",
+    "explored_union",
+    "explored_zone",
+    "free_zone",
+    "impact_bound",
+    "impact_zone",
+    "level_thick_image",
+    "localize",
+    "measurement_shapes",
+    "mission_tube",
+    "overlap_pretest",
+    "register_translation",
+    "shape_carve",
+    "shape_register",
+    "shape_slam",
+    "sweep_gates",
+]

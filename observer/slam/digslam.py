@@ -1,0 +1,229 @@
+"""The offline Dig-SLAM observer (thesis §6.4, Algorithm 6.3, Eq. 6.18–6.24).
+
+From a recorded mission (bounded speed, yaw rate, compass heading and range intervals) Dig-SLAM encloses
+the robot's positions in a tube, proves which cells are free (the dig zone ``M⁻``) and which were
+explored, and iterates the two contractors of the constraint network (6.24) to a fixpoint:
+
+1. ``[x](·) := C_d/dt([x](·))`` with ``ẋ = v (cos ψ, sin ψ)`` (Eq. 6.23), forward and backward;
+2. ``M⁻ := M⁻ ∪ g⁻¹_{[x](t_i)}(Z(t_i))`` for every reading (Eq. 6.21, :meth:`DigMap.dig_disks`,
+   :meth:`DigMap.dig_sectors`);
+3. ``[x](t_i) := C_g^≠([x](t_i), ΔZ(t_i), M⁻)`` (Eq. 6.22, :meth:`DigMap.contract_impacts`).
+
+Every step is a sound contractor, so the order does not matter for the guarantee: each iteration digs with
+all the gates, then contracts all the gates against the whole ``M⁻`` (a Jacobi sweep of Algorithm 6.3, at
+least as strong as its sequential loop since ``M⁻`` only grows). An empty gate means the data contradict
+their bounds: the result then says so (``consistent`` is False) and carries no sets.
+
+Data contract (:mod:`.record`): ``speed[k]`` and ``yaw_rate[k]`` bound the true values over the whole
+slice ``[t_{k-1}, t_k]`` that ends at ``t_k``; ``heading[k]`` bounds the heading at ``t_k``; ``range[k]``
+bounds the ranges from the pose at ``t_k``.
+
+>>> from digslam.observer.slam.record import MissionRecord
+>>> n = 11
+>>> rec = MissionRecord(t=np.arange(n) * 0.1, speed=np.tile([0.99, 1.01], (n, 1)),
+...     yaw_rate=np.tile([-0.01, 0.01], (n, 1)), heading=np.tile([-0.001, 0.001], (n, 1)),
+...     alpha=np.zeros((n, 1)), gamma=np.full((n, 1), np.pi), r_max=np.full((n, 1), 5.0),
+...     range=np.stack([2 - np.arange(n) * 0.1 - 0.01, 2 - np.arange(n) * 0.1 + 0.01], 1)[:, None],
+...     no_echo=np.zeros((n, 1), bool), outlier=np.zeros((n, 1), bool))        # a wall at x = 2
+>>> res = dig_slam(rec, Grid((-3.0, -3.0), (3.0, 3.0), (120, 120)), [0.0, 0.0], [0.0, 0.0])
+>>> res.consistent, bool(res.dig.free[60, 60]), bool(res.dig.free[60, 110])   # origin free, x=2.5 not
+(True, True, False)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from digslam.observer.core import rounding as rnd
+from digslam.observer.slam.digmap import DigMap
+from digslam.observer.slam.explored import explored_disks_grid, explored_union
+from digslam.observer.slam.grid import Grid
+from digslam.observer.slam.record import MissionRecord
+from digslam.observer.thick.sep import CLEAR, DARK, UNKNOWN
+from digslam.observer.tube.tube import Tube, ctc_deriv, heading_from_compass, unicycle_velocity
+
+
+@dataclass(frozen=True)
+class DigSlamConfig:
+    """Settings of :func:`dig_slam`.
+
+    Attributes:
+        max_iter: most fixpoint iterations (each digs, contracts the impacts and runs ``C_d/dt``).
+        tol: stop when an iteration shrinks the summed gate widths by less than this fraction.
+        impacts: apply the impact contractor (Eq. 6.22); without it the result is dead reckoning plus
+            digging (the thesis's "before contraction").
+        explored: compute the explored zone of the final tube (App. B).
+    """
+
+    max_iter: int = 10
+    tol: float = 5e-3
+    impacts: bool = True
+    explored: bool = True
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.max_iter, int) and self.max_iter >= 1):
+            raise ValueError(f"max_iter: must be an integer >= 1, got {self.max_iter!r}")
+        if not (np.isfinite(self.tol) and self.tol >= 0):
+            raise ValueError(f"tol: must be a finite number >= 0, got {self.tol!r}")
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> DigSlamConfig:
+        """Build from a mapping; an unknown key raises ``ValueError`` naming it."""
+        known = set(cls.__dataclass_fields__)
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ValueError(f"DigSlamConfig: unknown key(s) {unknown}; known: {sorted(known)}")
+        return cls(**data)
+
+
+@dataclass
+class DigSlamResult:
+    """Output of :func:`dig_slam`.
+
+    Attributes:
+        consistent: False when some gate became empty (the data contradict their bounds).
+        first_empty: index of the first empty gate, or None.
+        tube: the contracted position tube (None when inconsistent).
+        dig: the dig zone ``M⁻`` (None when inconsistent).
+        explored: the explored zone ``[Z⁻, Z⁺]`` on the grid (App. B), int8 codes of
+            :mod:`.thick_sep` (clear, penumbra, dark, unknown); None when inconsistent.
+        heading: the heading tube used for the velocity (compass and gyro fused).
+        iterations: fixpoint iterations run.
+        widths: per iteration, gate widths ``(T+1,)`` before the impact contractor, after it, and after
+            ``C_d/dt`` (keys ``"before"``, ``"impacts"``, ``"deriv"``); Fig. 6.13.
+        dead_reckoning: gate widths of the initial dead-reckoning tube.
+    """
+
+    consistent: bool
+    first_empty: int | None
+    tube: Tube | None
+    dig: DigMap | None
+    heading: Tube
+    iterations: int
+    widths: list[dict[str, np.ndarray]] = field(default_factory=list)
+    dead_reckoning: np.ndarray | None = None
+    explored: np.ndarray | None = None
+
+
+def explored_zone(grid: Grid, record: MissionRecord, tube: Tube, heading: Tube) -> np.ndarray:
+    """Explored zone of the readings (App. B patches): each sensor saw up to its true range.
+
+    The visible set of a reading is the disk or sector of radius ``y ∈ [y⁻, y⁺]`` (``r_max`` exactly for
+    no echo) around the pose of the gate. Disks go through :func:`explored_disks_grid` (clear, penumbra
+    and dark proofs). Sectors take the fast sound path: clear where the cell is inside the sector of
+    radius ``y⁻`` for every pose and heading (:meth:`DigMap.dig_sectors`), dark where it is proved outside
+    the disk of radius ``y⁺`` around every pose, unknown elsewhere (the full sector tests of
+    :func:`.explored_sweep.explored_sectors_grid` prove penumbra too but cost far more per reading).
+    The sensors' zones are joined by :func:`explored_union`.
+    """
+    lo_r = record.range[..., 0]
+    hi_r = np.where(record.no_echo, record.r_max, record.range[..., 1])
+    parts = []
+    k, s = np.nonzero(record.gamma >= rnd.PI_DOWN)
+    if k.size:
+        parts.append(explored_disks_grid(grid, tube.gate_lo[k], tube.gate_hi[k], lo_r[k, s], hi_r[k, s]))
+    k, s = np.nonzero(record.gamma < rnd.PI_DOWN)
+    if k.size:
+        st = explored_disks_grid(grid, tube.gate_lo[k], tube.gate_hi[k], np.zeros(k.size), hi_r[k, s])
+        sure = DigMap(grid)
+        sure.dig_sectors(tube.gate_lo[k], tube.gate_hi[k], heading.gate_lo[k, 0], heading.gate_hi[k, 0],
+                         record.alpha[k, s], record.gamma[k, s], lo_r[k, s])  # fmt: skip
+        part = np.where(st == DARK, DARK, UNKNOWN).astype(np.int8)
+        part[sure.free] = CLEAR
+        parts.append(part)
+    return explored_union(parts)
+
+
+def dig_readings(
+    dig: DigMap, record: MissionRecord, tube: Tube, heading: Tube, gates: np.ndarray | None = None
+) -> None:
+    """Eq. 6.21 for every reading (of the ``gates`` selected by a boolean mask, or all): omnidirectional
+    readings dig disks, sonar cones dig sectors."""
+    ok = np.isfinite(record.range[..., 0]) & (record.range[..., 0] > 0)
+    if gates is not None:
+        ok &= gates[:, None]
+    k, s = np.nonzero(ok)
+    lo, hi = tube.gate_lo[k], tube.gate_hi[k]
+    r = record.range[k, s, 0]
+    omni = record.gamma[k, s] >= rnd.PI_DOWN
+    dig.dig_disks(lo[omni], hi[omni], r[omni])
+    c = ~omni
+    dig.dig_sectors(lo[c], hi[c], heading.gate_lo[k[c], 0], heading.gate_hi[k[c], 0],
+                    record.alpha[k[c], s[c]], record.gamma[k[c], s[c]], r[c])  # fmt: skip
+
+
+def impact_bound(record: MissionRecord) -> np.ndarray:
+    """Per time, the smallest upper range bound over the echoing sensors (``inf`` if none echoed)."""
+    hi = np.where(record.no_echo, np.inf, record.range[..., 1])
+    return hi.min(axis=1)
+
+
+def dig_slam(
+    record: MissionRecord, grid: Grid, x0_lo: Any, x0_hi: Any, config: DigSlamConfig | None = None
+) -> DigSlamResult:
+    """Run Dig-SLAM (Algorithm 6.3) on a recorded mission to its fixpoint.
+
+    Args:
+        record: a stacked mission of ``T + 1`` samples (see the data contract above).
+        grid: the cells of ``M⁻`` (they must cover the region the robot senses).
+        x0_lo, x0_hi: the initial position box ``X₀`` (Eq. 6.15).
+        config: :class:`DigSlamConfig` (defaults when None).
+
+    Returns:
+        A :class:`DigSlamResult`; check ``consistent`` before using the sets.
+
+    Raises:
+        ValueError: on a single-step record, or an initial box that is not a 2-d box.
+    """
+    cfg = config or DigSlamConfig()
+    if record.t.ndim != 1 or len(record) < 2:
+        raise ValueError("record: expected a stacked mission of at least two samples")
+    x0_lo, x0_hi = np.asarray(x0_lo, dtype=np.float64), np.asarray(x0_hi, dtype=np.float64)
+    if x0_lo.shape != (2,) or x0_hi.shape != (2,) or np.any(x0_lo > x0_hi) or np.isnan(x0_lo + x0_hi).any():
+        raise ValueError(f"x0_lo, x0_hi: expected a 2-d box, got {x0_lo} and {x0_hi}")
+    t = record.t
+    heading = heading_from_compass(t, record.heading[:, 0], record.heading[:, 1],
+                                   record.yaw_rate[1:, 0], record.yaw_rate[1:, 1])  # fmt: skip
+    if heading.is_empty():  # compass and gyro contradict each other
+        at = heading.inconsistent_at if heading.inconsistent_at is not None else heading.first_empty()
+        return DigSlamResult(False, at, None, None, heading, 0)
+    u_lo, u_hi = unicycle_velocity(record.speed[1:, 0], record.speed[1:, 1],
+                                   heading.slice_lo[:, 0], heading.slice_hi[:, 0])  # fmt: skip
+    n = t.shape[0]
+    g_lo, g_hi = np.full((n, 2), -np.inf), np.full((n, 2), np.inf)
+    g_lo[0], g_hi[0] = x0_lo, x0_hi
+    tube = ctc_deriv(Tube(t, g_lo, g_hi), u_lo, u_hi, forward=True, backward=False)
+    res = DigSlamResult(True, None, tube, DigMap(grid), heading, 0, dead_reckoning=tube.widths())
+    r_hi = impact_bound(record)
+    total = float(np.sum(tube.widths()))
+    dug_lo, dug_hi = np.full_like(tube.gate_lo, np.nan), np.full_like(tube.gate_hi, np.nan)
+    for it in range(cfg.max_iter):
+        before = tube.widths()
+        # a gate dug before and unchanged since digs nothing new
+        changed = np.any((tube.gate_lo != dug_lo) | (tube.gate_hi != dug_hi), axis=1)
+        dig_readings(res.dig, record, tube, heading, changed)
+        dug_lo, dug_hi = tube.gate_lo.copy(), tube.gate_hi.copy()
+        if cfg.impacts:
+            lo, hi = res.dig.contract_impacts(tube.gate_lo, tube.gate_hi, r_hi)
+            tube = Tube(t, lo, hi, tube.slice_lo, tube.slice_hi)
+        after = tube.widths()
+        tube = ctc_deriv(tube, u_lo, u_hi)
+        res.iterations = it + 1
+        res.widths.append({"before": before, "impacts": after, "deriv": tube.widths()})
+        if tube.is_empty():
+            at = tube.inconsistent_at if tube.inconsistent_at is not None else tube.first_empty()
+            return DigSlamResult(False, at, None, None, heading, it + 1, res.widths, res.dead_reckoning)
+        new_total = float(np.sum(tube.widths()))
+        if not cfg.impacts or total - new_total <= cfg.tol * total:
+            break
+        total = new_total
+    res.tube = tube
+    if cfg.explored:
+        res.explored = explored_zone(grid, record, tube, heading)
+    return res
+
+
+__all__ = ["DigSlamConfig", "DigSlamResult", "dig_readings", "dig_slam", "explored_zone", "impact_bound"]

@@ -1,0 +1,38 @@
+"""Tubes (Sec. 6.2, App. B): boxes over time that hold a trajectory.
+
+Lives here: :mod:`.tube` (``Tube``, dead reckoning, headings from compass and gyro) and :mod:`.ctc` (the
+derivative contractor and the velocity models: unicycle, body-frame velocity ``x' = R(psi) v``, Eq.
+3.59/B.20).
+
+May import: :mod:`digslam.observer.core`; numpy.
+"""
+
+from .ctc import (
+    body_velocity,
+    cumsum_enclosure,
+    deriv_arrays,
+    increments,
+    maxplus_lower,
+    unicycle_velocity,
+)
+from .tube import (
+    Tube,
+    ctc_deriv,
+    dead_reckoning,
+    heading_from_compass,
+    heading_from_gyro,
+)
+
+__all__ = [
+    "Tube",
+    "body_velocity",
+    "ctc_deriv",
+    "cumsum_enclosure",
+    "dead_reckoning",
+    "deriv_arrays",
+    "heading_from_compass",
+    "heading_from_gyro",
+    "increments",
+    "maxplus_lower",
+    "unicycle_velocity",
+]

@@ -1,0 +1,154 @@
+"""PPO training recipe: TrainConfig validation, the features extractor, spawn-safe env factories, training."""
+
+from __future__ import annotations
+
+import json
+import pickle
+
+import numpy as np
+import pytest
+
+pytest.importorskip("stable_baselines3")
+torch = pytest.importorskip("torch")
+
+import gymnasium as gym  # noqa: E402
+from gymnasium import spaces  # noqa: E402
+
+from digslam.agents.learning.extractor import MapStateExtractor, conv_plan  # noqa: E402
+from digslam.agents.learning.train import DEFAULT_CONFIG, EnvFactory, TrainConfig, parse_value  # noqa: E402
+
+
+def _space(c: int, m: int) -> spaces.Dict:
+    return spaces.Dict(
+        {"map": spaces.Box(0, 255, (c, m, m), np.uint8), "state": spaces.Box(-1, 1, (11,), np.float32)}
+    )
+
+
+def test_default_file_is_the_default_config_and_overrides_are_typed() -> None:
+    assert DEFAULT_CONFIG.is_file() and TrainConfig.from_file() == TrainConfig()
+    cfg = TrainConfig.from_file(None, ["n_envs=1", "learning_rate=1e-4", "env_kwargs.map_size=48",
+                                       'out_dir="x"', "progress_bar=false", "gamma=1"])  # fmt: skip
+    assert (cfg.n_envs, cfg.learning_rate, cfg.out_dir, cfg.progress_bar) == (1, 1e-4, "x", False)
+    assert cfg.env_kwargs == {**TrainConfig().env_kwargs, "map_size": 48} and isinstance(cfg.gamma, float)
+    assert cfg.override(["out_dir=plain"]).out_dir == "plain"  # an unquoted string stays a string
+    assert parse_value("{map_size = 40, crop = 4.0}") == {"map_size": 40, "crop": 4.0}
+    assert TrainConfig().eval_seeds() == (500, 501, 502) and TrainConfig().train_seeds() == (0, 1)
+
+
+def test_config_files_toml_and_json(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    j = tmp_path / "c.json"
+    j.write_text(json.dumps({"n_envs": 3, "env_kwargs": {"map_size": 40}}))
+    assert TrainConfig.from_file(j).n_envs == 3
+    t = tmp_path / "c.toml"
+    t.write_text("n_envs = 1\ntotal_timez = 5\n[env_kwargs]\nmap_size = 36\n")
+    with pytest.raises(ValueError, match="total_timez"):
+        TrainConfig.from_file(t)
+    with pytest.raises(ValueError, match="path"):
+        TrainConfig.from_file(tmp_path / "missing.toml")
+    y = tmp_path / "c.yaml"
+    y.write_text("n_envs: 1")
+    with pytest.raises(ValueError, match="path"):
+        TrainConfig.from_file(y)
+
+
+@pytest.mark.parametrize(
+    ("override", "key"),
+    [
+        ("n_env=2", "n_env"),
+        ("n_envs=two", "n_envs"),
+        ("n_envs=2.5", "n_envs"),
+        ("learning_rate=fast", "learning_rate"),
+        ("progress_bar=1", "progress_bar"),
+        ("env_kwargs=3", "env_kwargs"),
+        ("n_steps=0", "n_steps"),
+        ("gamma=1.5", "gamma"),
+        ("eval_seed=1", "eval_seed"),  # held-out seeds meet the training seeds 0, 1
+        ("seed.x=1", "seed.x"),
+        ("noequals", "overrides"),
+    ],
+)
+def test_bad_keys_and_types_raise_value_error_naming_the_key(override: str, key: str) -> None:
+    with pytest.raises(ValueError, match=key.replace(".", r"\.")):
+        TrainConfig().override([override])
+
+
+def test_unknown_key_in_constructor_and_from_dict() -> None:
+    with pytest.raises(ValueError, match="batchsize"):
+        TrainConfig.from_dict({"batchsize": 64})
+    with pytest.raises(ValueError, match="features_dim"):
+        TrainConfig(features_dim=0)
+
+
+@pytest.mark.parametrize(("c", "m"), [(4, 36), (7, 36), (4, 64), (7, 64), (7, 40), (4, 48), (4, 100)])
+def test_extractor_sizes_itself_from_the_space(c: int, m: int) -> None:
+    ext = MapStateExtractor(_space(c, m), features_dim=32)
+    x = {"map": torch.rand(3, c, m, m), "state": torch.rand(3, 11) * 2 - 1}
+    y = ext(x)
+    assert y.shape == (3, 32) and torch.all(y >= 0)
+    assert ext.cnn[0].in_channels == c and len(conv_plan(m)) >= 2
+
+
+def test_extractor_bad_input() -> None:
+    with pytest.raises(ValueError, match="observation_space"):
+        MapStateExtractor(spaces.Box(0, 1, (4, 36, 36)))
+    with pytest.raises(ValueError, match="observation_space"):
+        MapStateExtractor(
+            spaces.Dict({"map": spaces.Box(0, 255, (4, 36, 40), np.uint8), "state": spaces.Box(-1, 1, (11,))})
+        )
+    with pytest.raises(ValueError, match="features_dim"):
+        MapStateExtractor(_space(4, 36), features_dim=0)
+    with pytest.raises(ValueError, match="side"):
+        conv_plan(2)
+
+
+def test_env_factory_is_picklable_and_cycles_held_out_seeds() -> None:
+    fac = EnvFactory("digslam/DigCoverage-v0", {"map_size": 36, "crop": 4.0}, 1, (500, 501))
+    fac2 = pickle.loads(pickle.dumps(fac))
+    assert fac2 == fac
+    env = fac2()
+    o1, _ = env.reset()
+    o2, _ = env.reset()
+    o3, _ = env.reset()
+    ref = gym.make("digslam/DigCoverage-v0", map_size=36, crop=4.0)
+    r1, _ = ref.reset(seed=500)
+    r2, _ = ref.reset(seed=501)
+    assert o1["map"].shape == (7, 36, 36)
+    assert all(np.array_equal(o1[k], r1[k]) and np.array_equal(o2[k], r2[k]) for k in o1)
+    assert all(np.array_equal(o3[k], r1[k]) for k in o1)  # back to the first held-out map
+    env.close()
+    ref.close()
+
+
+def test_ppo_with_the_extractor_predicts_on_the_env() -> None:
+    from digslam.agents.learning.train import build_model, make_vec_env
+
+    cfg = TrainConfig(n_envs=1, n_steps=16, batch_size=16, features_dim=16)
+    vec = make_vec_env(EnvFactory(cfg.env_id, cfg.env_kwargs, 1), 1, 0)
+    model = build_model(cfg, vec)
+    obs = vec.reset()
+    action, _ = model.predict(obs, deterministic=True)
+    assert action.shape == (1, 2) and np.all(np.abs(action) <= 1)
+    vec.close()
+
+
+@pytest.mark.expensive
+def test_train_end_to_end_gives_a_loadable_model(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from stable_baselines3 import PPO
+
+    from digslam.agents.learning.train import train
+
+    cfg = TrainConfig.from_file(None, [
+        "n_envs=2", "total_timesteps=256", "n_steps=64", "batch_size=64", "n_epochs=1", "features_dim=32",
+        "eval_freq=128", "eval_maps=1", "checkpoint_freq=128", "progress_bar=false",
+        "env_kwargs.max_episode_steps=50", f'out_dir="{tmp_path.as_posix()}"',
+    ])  # fmt: skip
+    path = train(cfg)
+    assert path.is_file() and (tmp_path / "best_model.zip").is_file()
+    assert any((tmp_path / "checkpoints").glob("*.zip")) and any((tmp_path / "tb").iterdir())
+    assert json.loads((tmp_path / "config.json").read_text())["total_timesteps"] == 256
+    model = PPO.load(path, device="cpu")
+    env = gym.make("digslam/DigCoverage-v0", **TrainConfig().env_kwargs)
+    obs, _ = env.reset(seed=1)
+    action, _ = model.predict(obs, deterministic=True)
+    assert env.action_space.contains(action)
+    assert model.num_timesteps >= 256

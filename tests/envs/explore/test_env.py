@@ -1,0 +1,238 @@
+"""``digslam/Explore-v0`` and its variants: API conformance, determinism, vector envs, replay, bad input."""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import digslam.envs
+from digslam.envs import Episode, ExploreConfig, ExploreEnv, record_episode, replay
+from digslam.observer.slam.record import MissionRecord
+
+IDS = list(digslam.envs.ENV_IDS)
+
+
+@pytest.fixture(autouse=True)
+def _headless(monkeypatch: pytest.MonkeyPatch) -> None:
+    """check_env also renders in "human" mode: keep pygame headless."""
+    monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")
+
+
+def _actions(n: int, seed: int = 0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    return rng.uniform(-1, 1, (n, 2)).astype(np.float32)
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_check_env_passes(env_id: str) -> None:
+    env = gym.make(env_id, render_mode="rgb_array")
+    check_env(env.unwrapped, skip_render_check=False)
+    env.close()
+
+
+@pytest.mark.parametrize("env_id", ["digslam/Explore-v0", "digslam/ExploreOutliers-v0"])
+def test_same_seed_and_actions_give_identical_results(env_id: str) -> None:
+    runs = []
+    for _ in range(2):
+        env = gym.make(env_id)
+        obs, info = env.reset(seed=42)
+        out = [(obs, 0.0, info)]
+        for a in _actions(60):
+            obs, r, _, _, info = env.step(a)
+            out.append((obs, r, info))
+        runs.append(out)
+    for (o1, r1, i1), (o2, r2, i2) in zip(*runs, strict=True):
+        assert all(np.array_equal(o1[k], o2[k]) for k in o1)
+        assert r1 == r2 and i1["record"] == i2["record"] and i1["truth"] == i2["truth"]
+        assert i1["coverage"] == i2["coverage"]
+    env = gym.make(env_id)
+    env.reset(seed=43)
+    other = [env.step(a)[2] for a in _actions(60)]
+    assert other != [r for _, r, _ in runs[0][1:]]
+
+
+@pytest.mark.parametrize("model", ["uniform", "adversarial", "biased"])
+def test_observation_matches_record_and_truth_is_inside(model: str) -> None:
+    env = gym.make("digslam/ExploreRocks-v0", noise={"model": model, "range": 0.05})
+    obs, info = env.reset(seed=3)
+    for a in _actions(100, 1):
+        obs, reward, term, trunc, info = env.step(a)
+        rec, truth = info["record"], info["truth"]
+        assert isinstance(rec, MissionRecord) and env.observation_space.contains(obs)
+        assert reward >= 0.0
+        assert rec.speed[0] <= truth.speed <= rec.speed[1]
+        assert rec.yaw_rate[0] <= truth.yaw_rate <= rec.yaw_rate[1]
+        assert rec.heading[0] <= truth.pose[2] <= rec.heading[1]
+        assert np.all(rec.range[:, 0] <= truth.ranges) and np.all(truth.ranges <= rec.range[:, 1])
+        assert np.array_equal(obs["no_echo"].astype(bool), rec.no_echo)
+        assert np.allclose(obs["ranges"][~rec.no_echo], rec.range[~rec.no_echo])
+        assert "pose" not in rec.as_dict()  # ground truth kept apart from the measurements
+
+
+def test_reward_is_the_newly_covered_free_area() -> None:
+    env = gym.make("digslam/Explore-v0")
+    env.reset(seed=0)
+    cov = env.unwrapped.coverage
+    before = np.count_nonzero(cov.seen)
+    total = 0.0
+    for a in _actions(50, 2):
+        total += env.step(a)[1]
+    assert total == pytest.approx((np.count_nonzero(cov.seen) - before) * cov.cell_area)
+    assert not np.any(cov.seen & ~cov.free)
+
+
+def test_time_limit_truncates() -> None:
+    env = gym.make("digslam/Explore-v0", max_episode_steps=5)
+    env.reset(seed=0)
+    flags = [env.step(np.zeros(2, dtype=np.float32))[3] for _ in range(5)]
+    assert flags == [False] * 4 + [True]
+
+
+@pytest.mark.parametrize("mode", ["sync", "async"])
+def test_gymnasium_vector_env(mode: str) -> None:
+    envs = gym.make_vec("digslam/ExploreRocks-v0", num_envs=2, vectorization_mode=mode)
+    obs, info = envs.reset(seed=[1, 2])
+    assert obs["ranges"].shape == (2, 9, 2)
+    for _ in range(5):
+        obs, rew, term, trunc, info = envs.step(envs.action_space.sample())
+    assert rew.shape == (2,) and "record" in info
+    envs.close()
+
+
+def test_sb3_subproc_vec_env() -> None:
+    pytest.importorskip("stable_baselines3")
+    from stable_baselines3.common.env_util import make_vec_env
+    from stable_baselines3.common.vec_env import SubprocVecEnv
+
+    # "module:id" makes each worker process import digslam.envs (registering the ids) before gym.make.
+    venv = make_vec_env("digslam.envs:digslam/Explore-v0", n_envs=2, seed=0, vec_env_cls=SubprocVecEnv)
+    obs = venv.reset()
+    assert obs["ranges"].shape == (2, 9, 2)
+    for _ in range(5):
+        obs, rew, done, infos = venv.step(np.stack([venv.action_space.sample() for _ in range(2)]))
+    assert rew.shape == (2,) and isinstance(infos[0]["record"], MissionRecord)
+    venv.close()
+
+
+def test_sb3_env_checker() -> None:
+    pytest.importorskip("stable_baselines3")
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+    sb3_check_env(gym.make("digslam/ExploreRocks-v0"), warn=False)
+
+
+def test_recorded_episode_replays_to_identical_records(tmp_path: Path) -> None:
+    env = gym.make("digslam/ExploreCaves-v0", noise={"outlier_prob": 0.1})
+    ep = record_episode(env, 9, _actions(80, 3))
+    assert len(ep.records) == 81 and ep.records.range.shape == (81, 9, 2)
+    ep.save(tmp_path / "ep.npz")
+    loaded = Episode.load(tmp_path / "ep.npz")
+    assert loaded.records == ep.records and loaded.truth == ep.truth and loaded.config == ep.config
+    again = replay(loaded)
+    assert again.records == ep.records and again.truth == ep.truth
+    ep.records.save_npz(tmp_path / "rec.npz")
+    assert MissionRecord.load_npz(tmp_path / "rec.npz") == ep.records
+
+
+def test_render_modes(tmp_path: Path) -> None:
+    env = gym.make("digslam/ExploreRooms-v0", render_mode="rgb_array")
+    env.reset(seed=0)
+    env.step(np.array([1.0, 0.3], dtype=np.float32))
+    img = env.render()
+    assert (
+        img.shape == (512, 512, 3)
+        and img.dtype == np.uint8
+        and len(np.unique(img.reshape(-1, 3), axis=0)) > 4
+    )
+    env.close()
+    env = gym.make("digslam/Explore-v0", render_mode="human")
+    env.reset(seed=0)
+    env.step(np.array([1.0, 0.0], dtype=np.float32))
+    assert env.render() is None
+    env.close()
+
+
+def test_fixed_world_and_new_worlds() -> None:
+    env = ExploreEnv(world="rocks")
+    env.reset(seed=1)
+    w = env.world
+    env.reset()
+    assert env.world is w
+    env = ExploreEnv(world="rocks", fixed_world=False)
+    env.reset(seed=1)
+    w = env.world
+    env.reset()
+    assert not np.array_equal(env.world.edges, w.edges)
+
+
+def test_bad_input_errors_name_the_field() -> None:
+    with pytest.raises(ValueError, match="sonar_rnage"):
+        gym.make("digslam/Explore-v0", sonar_rnage=3.0)
+    with pytest.raises(ValueError, match="sonar_gamma"):
+        ExploreEnv(sonar_gamma=0.0)
+    with pytest.raises(ValueError, match="sonar_gamma"):
+        ExploreEnv(sonar_gamma=math.pi + 0.01)
+    with pytest.raises(ValueError, match="noise.range"):
+        gym.make("digslam/Explore-v0", noise={"range": -0.01})
+    with pytest.raises(ValueError, match="world"):
+        ExploreConfig(world="moon")
+    with pytest.raises(ValueError, match="map_path"):
+        ExploreConfig(world="file")
+    env = gym.make("digslam/Explore-v0")
+    env.reset(seed=0)
+    for bad in ([1.5, 0.0], [np.nan, 0.0], [0.0, -np.inf], [0.1, 0.2, 0.3]):
+        with pytest.raises(ValueError, match="action"):
+            env.step(np.array(bad, dtype=np.float32))
+    with pytest.raises(ValueError, match="start"):
+        ExploreEnv(world="room", start=(9.5, 9.5, 0.0)).reset(seed=0)  # outside the room's polygon
+    env = ExploreEnv(world="rocks")
+    env.reset(seed=0)
+    rock = env.world.rings[1].mean(axis=0)
+    with pytest.raises(ValueError, match="start"):
+        ExploreEnv(world="rocks", start=(float(rock[0]), float(rock[1]), 0.0)).reset(seed=0)
+
+
+def test_user_map_file(tmp_path: Path) -> None:
+    free = np.ones((60, 60), dtype=bool)
+    free[10:20, 25:35] = False  # a block north of the centre (row 0 is the top)
+    np.save(tmp_path / "map.npy", free)
+    env = gym.make("digslam/Explore-v0", world="file", map_path=str(tmp_path / "map.npy"), world_size=6.0)
+    obs, info = env.reset(seed=0)
+    assert env.unwrapped.world.name == "map" and env.observation_space.contains(obs)
+    for a in _actions(20):
+        env.step(a)
+    with pytest.raises(ValueError, match="map_path"):
+        gym.make("digslam/Explore-v0", world="file", map_path=str(tmp_path / "nope.npy"))
+
+
+def test_config_is_frozen_and_replace_checks_keys() -> None:
+    cfg = ExploreConfig()
+    with pytest.raises(AttributeError):
+        cfg.dt = 0.2  # type: ignore[misc]
+    assert cfg.replace(dt=0.2).dt == 0.2
+    with pytest.raises(ValueError, match="dtt"):
+        cfg.replace(dtt=0.2)
+    with pytest.raises(ValueError, match="sonar_rnage"):
+        ExploreConfig(sonar_rnage=3.0)  # the constructor too, not only from_dict
+    assert ExploreConfig.from_dict({"noise": {"model": "biased"}}).noise.model == "biased"
+
+
+def test_example_script_writes_a_png(tmp_path: Path) -> None:
+    import subprocess
+    import sys
+
+    script = Path(__file__).resolve().parents[3] / "examples" / "explore_env.py"
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy"}
+    subprocess.run(
+        [sys.executable, str(script), str(tmp_path), "--steps", "20"],
+        check=True,
+        env=env,
+        capture_output=True,
+    )
+    assert (tmp_path / "Explore-v0.png").stat().st_size > 1000

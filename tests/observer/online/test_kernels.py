@@ -1,0 +1,423 @@
+"""Compiled kernels of the online filter against the previous numpy kernels (kept here as oracles) and the truth.
+
+The oracles are the numpy implementations that the compiled kernels replaced (round-to-nearest tests
+against the relative margin ``MARGIN``). The compiled kernels prove every claim with outward rounding, so
+they may differ from the oracles only at cell borders (a few cells): the dug cells are those of the rigorous
+offline :class:`DigMap`; the compiled possibly-sensed zone can be a few cells tighter than the oracle's (it
+also uses the sector's bounding box). Soundness is checked by sampling against exact geometry and by the
+shared ground-truth checks of a whole mission.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from ground_truth import assert_free
+
+from digslam.envs.config import NoiseConfig
+from digslam.envs.dig_coverage.maps_jit import fill_map, observer_sets, three_state
+from digslam.envs.sim.missions import loop_mission
+from digslam.envs.sim.sensors import SensorSuite
+from digslam.envs.world.generators import ThesisRoom
+from digslam.observer.core import rounding as rnd
+from digslam.observer.online.observer import OnlineDigSlam
+from digslam.observer.online.pose_jit import cos_sin, predict
+from digslam.observer.online.window import MARGIN, WindowDigMap, mark_possibly_sensed
+from digslam.observer.slam.digmap import EDT_SLACK, DigMap
+from digslam.observer.slam.grid import Grid
+from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+
+G = Grid((-6.0, -6.0), (6.0, 6.0), (96, 96))
+
+
+# ------------------------------------------------------------------ numpy oracles (the previous kernels)
+def oracle_dig_disk(free: np.ndarray, lo: np.ndarray, hi: np.ndarray, r: float) -> None:
+    ys = G.ys
+    my = np.maximum(ys[:-1] - lo[1], hi[1] - ys[1:])
+    s2 = r * r * (1 - MARGIN) - my * my * (1 + MARGIN)
+    s = np.sqrt(np.maximum(s2, 0.0)) * (1 - MARGIN)
+    a = (lo[0] + s) - MARGIN * (abs(lo[0]) + s)
+    b = (hi[0] - s) + MARGIN * (abs(hi[0]) + s)
+    c_hi, c_lo = np.searchsorted(G.xs, a, side="left") - 1, np.searchsorted(G.xs, b, side="right")
+    cols = np.arange(G.shape[1])[None, :]
+    free |= (s2 > 0)[:, None] & (cols >= c_lo[:, None]) & (cols < c_hi[:, None])
+
+
+def oracle_dig_cone(
+    free: np.ndarray, lo: np.ndarray, hi: np.ndarray, th1: float, th2: float, r: float
+) -> None:
+    row, col = np.nonzero(~free)
+    dxl, dyl = G.xs[col] - hi[0], G.ys[row + 1] - hi[1]
+    dxh, dyh = G.xs[col + 1] - lo[0], G.ys[row] - lo[1]
+    fx, fy = np.maximum(-dxl, dxh), np.maximum(-dyl, dyh)
+    good = (fx * fx + fy * fy) * (1 + MARGIN) < (r * r) * (1 - MARGIN)
+    tol = MARGIN * (fx + fy)
+    c1, s1, c2, s2 = math.cos(th1), math.sin(th1), math.cos(th2), math.sin(th2)
+    good &= np.minimum(c1 * dyl, c1 * dyh) - np.maximum(s1 * dxl, s1 * dxh) >= tol
+    good &= np.minimum(s2 * dxl, s2 * dxh) - np.maximum(c2 * dyl, c2 * dyh) >= tol
+    free[row[good], col[good]] = True
+
+
+def oracle_dig_sector(free, lo, hi, psi_lo, psi_hi, alpha, gamma, r) -> None:  # noqa: ANN001
+    up, down = rnd.step_up, rnd.step_down
+    th1, th2 = float(up(up(psi_hi + alpha) - gamma)), float(down(down(psi_lo + alpha) + gamma))
+    if th1 > th2:
+        return
+    if float(up(th2 - th1)) > rnd.PI_DOWN:
+        oracle_dig_cone(free, lo, hi, th1, float(down(th1 + rnd.PI_DOWN)), r)
+        oracle_dig_cone(free, lo, hi, float(up(th2 - rnd.PI_DOWN)), th2, r)
+    else:
+        oracle_dig_cone(free, lo, hi, th1, th2, r)
+
+
+def oracle_mark(maybe, lo, hi, psi_lo, psi_hi, alpha, gamma, r_hi) -> None:  # noqa: ANN001
+    rows, cols = np.nonzero(~maybe)
+    dxl, dxh = G.xs[cols] - hi[0], G.xs[cols + 1] - lo[0]
+    dyl, dyh = G.ys[rows + 1] - hi[1], G.ys[rows] - lo[1]
+    mx, my = np.maximum(np.maximum(dxl, -dxh), 0.0), np.maximum(np.maximum(dyl, -dyh), 0.0)
+    near2 = (mx * mx + my * my) * (1 - MARGIN)
+    r2 = (r_hi * r_hi) * (1 + MARGIN) + 1e-300
+    th1 = rnd.step_down(rnd.step_down(psi_lo + alpha) - gamma)
+    th2 = rnd.step_up(rnd.step_up(psi_hi + alpha) + gamma)
+    narrow = rnd.step_up(th2 - th1) <= rnd.HALF_PI_DOWN
+    hit = near2[None, :] <= r2[:, None]
+    tol = MARGIN * (np.maximum(-dxl, dxh) + np.maximum(-dyl, dyh))
+    c1, s1, c2, s2 = (f(t)[:, None] for t in (th1, th2) for f in (np.cos, np.sin))
+    out = np.maximum(c1 * dyl, c1 * dyh) - np.minimum(s1 * dxl, s1 * dxh) < -tol
+    out |= np.maximum(s2 * dxl, s2 * dxh) - np.minimum(c2 * dyl, c2 * dyh) < -tol
+    e = 1e-15
+    out |= ((c1 >= e) & (c2 >= e)) & (dxh < 0) | ((c1 <= -e) & (c2 <= -e)) & (dxl > 0)
+    out |= ((s1 >= e) & (s2 >= e)) & (dyh < 0) | ((s1 <= -e) & (s2 <= -e)) & (dyl > 0)
+    hit &= ~(out & narrow[:, None])
+    mark = hit.any(axis=0)
+    maybe[rows[mark], cols[mark]] = True
+
+
+def oracle_clearance_cells(free, b0, b1, a0, a1, window) -> np.ndarray:  # noqa: ANN001
+    w0, w1, v0, v1 = window
+    sub = free[w0:w1, v0:v1]
+    nr, nc = np.nonzero(~sub)
+    dx, dy = G.cell_size
+    pr, pc = np.arange(b0 - w0, b1 - w0)[:, None, None], np.arange(a0 - v0, a1 - v0)[None, :, None]
+    d2 = np.min(((pr - nr) * dy) ** 2 + ((pc - nc) * dx) ** 2, axis=2, initial=np.inf)
+    ring = np.minimum(np.minimum(pr[..., 0] + 1, w1 - w0 - pr[..., 0]) * dy,
+                      np.minimum(pc[..., 0] + 1, v1 - v0 - pc[..., 0]) * dx)  # fmt: skip
+    d = np.minimum(np.sqrt(d2), ring)
+    diag = float(np.hypot(dx, dy)) * (1 + EDT_SLACK)
+    low = rnd.step_down(d * (1 - EDT_SLACK) - (diag + EDT_SLACK * 12.0))
+    return np.where(sub[b0 - w0 : b1 - w0, a0 - v0 : a1 - v0], np.maximum(low, 0.0), 0.0)
+
+
+def oracle_contract(m: WindowDigMap, lo: np.ndarray, hi: np.ndarray, r_hi: float) -> tuple[np.ndarray, ...]:
+    b0, b1, a0, a1 = m.win(lo, hi)
+    reach = r_hi + 2.0 * max(G.cell_size)
+    feas = oracle_clearance_cells(m.free, b0, b1, a0, a1, m.win(lo - reach, hi + reach)) <= r_hi
+    rows, cols = np.flatnonzero(feas.any(axis=1)), np.flatnonzero(feas.any(axis=0))
+    if not rows.size:
+        return np.full(2, np.inf), np.full(2, -np.inf)
+    return (np.array([max(lo[0], G.xs[a0 + cols[0]]), max(lo[1], G.ys[b0 + rows[-1] + 1])]),
+            np.array([min(hi[0], G.xs[a0 + cols[-1] + 1]), min(hi[1], G.ys[b0 + rows[0]])]))  # fmt: skip
+
+
+# ------------------------------------------------------------------ exact checks by sampling
+def _cell_points(rows: np.ndarray, cols: np.ndarray, rng: np.random.Generator, k: int) -> np.ndarray:
+    lo, hi = G.cell_boxes(rows, cols)
+    u = rng.random((k, rows.size, 2))
+    u[0], u[1] = 0.0, 1.0  # two corners
+    return lo + (hi - lo) * u  # (k, cells, 2)
+
+
+def _random_reading(rng: np.random.Generator) -> tuple:
+    lo = rng.uniform(-3, 3, 2)
+    hi = lo + rng.uniform(0, 0.6, 2)
+    psi_lo = rng.uniform(-7, 7)
+    psi_hi = psi_lo + rng.choice([0.0, 0.05, 0.5])
+    alpha, gamma = rng.uniform(-3.2, 3.2), rng.choice([0.05, np.pi / 12, 0.7, 2.0, np.pi])
+    return lo, hi, psi_lo, psi_hi, alpha, gamma, rng.uniform(0.2, 3.5)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_dig_agrees_with_the_numpy_oracle_and_is_sound(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    for _ in range(25):
+        lo, hi, psi_lo, psi_hi, alpha, gamma, r = _random_reading(rng)
+        ref, exact, jit = np.zeros(G.shape, bool), DigMap(G), WindowDigMap(G)
+        if gamma == np.pi and rng.random() < 0.5:  # the omni disk
+            oracle_dig_disk(ref, lo, hi, r)
+            exact.dig_disks(lo[None], hi[None], [r])
+            jit.dig_disks(lo[None], hi[None], [r])
+            sector = None
+        else:
+            oracle_dig_sector(ref, lo, hi, psi_lo, psi_hi, alpha, gamma, r)
+            args = ([psi_lo], [psi_hi], [alpha], [gamma], [r])
+            exact.dig_sectors(lo[None], hi[None], *args)
+            jit.dig_sectors(lo[None], hi[None], *args)
+            sector = (psi_lo, psi_hi, alpha, gamma)
+        got = jit.free
+        assert (got & ~ref).sum() <= 2 and (ref & ~got).sum() <= 2  # equal up to cell borders
+        assert not np.any(got & ~exact.free)  # never more than the rigorous offline DigMap proves
+        rows, cols = np.nonzero(got)
+        if not rows.size:
+            continue
+        # every point of a dug cell is strictly within r of every pose, inside the sector for every heading
+        p = _cell_points(rows, cols, rng, 6)
+        x = lo + (hi - lo) * rng.random((6, 1, 2))
+        d = p - x
+        assert np.all(np.hypot(d[..., 0], d[..., 1]) < r)
+        if sector is not None:
+            psi = rng.uniform(psi_lo, psi_hi, (6, 1))
+            off = np.angle(np.exp(1j * (np.arctan2(d[..., 1], d[..., 0]) - psi - alpha)))
+            assert np.all(np.abs(off) <= gamma + 1e-12)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_possibly_sensed_contains_the_oracle_and_every_sensed_point(seed: int) -> None:
+    rng = np.random.default_rng(10 + seed)
+    for _ in range(25):
+        lo, hi, psi_lo, psi_hi, _, _, _ = _random_reading(rng)
+        alpha, gamma = rng.uniform(-3.2, 3.2, 3), rng.choice([0.05, np.pi / 12, 1.0, np.pi], 3)
+        r = rng.uniform(0.2, 3.5, 3)
+        ref, got = np.zeros(G.shape, bool), np.zeros(G.shape, bool)
+        oracle_mark(ref, lo, hi, psi_lo, psi_hi, alpha, gamma, r)
+        mark_possibly_sensed(G, got, lo, hi, psi_lo, psi_hi, alpha, gamma, r)
+        assert (ref & ~got).sum() <= 3 and (got & ~ref).sum() <= 3  # equal up to cell borders
+        # the cells the compiled kernel proves dark and the oracle does not: proved by the sector's bounding
+        # box (apex, arc ends, axis points), which the oracle did not use; check them with dense samples
+        only = ref & ~got
+        m = 40000 if only.any() else 4000
+        x = lo + (hi - lo) * rng.random((m, 2))
+        s = rng.integers(0, 3, m)
+        th = rng.uniform(psi_lo, psi_hi, m) + alpha[s] + gamma[s] * rng.uniform(-1, 1, m)
+        rho = r[s] * np.sqrt(rng.random(m))
+        rho[:50] = r[s[:50]]  # on the arc
+        px, py = x[:, 0] + rho * np.cos(th), x[:, 1] + rho * np.sin(th)
+        col = np.clip(np.searchsorted(G.xs, px) - 1, 0, G.shape[1] - 1)
+        row = np.clip(np.searchsorted(-G.ys, -py) - 1, 0, G.shape[0] - 1)
+        assert np.all(got[row, col]) and not np.any(only[row, col])
+
+
+def test_contraction_equals_the_oracle() -> None:
+    rng = np.random.default_rng(3)
+    for _ in range(30):
+        m = WindowDigMap(G)
+        c = rng.uniform(-3, 3, (4, 2))
+        m.dig_disks(c - 0.2, c + 0.2, rng.uniform(0.5, 2.5, 4))
+        lo = rng.uniform(-3, 3, 2)
+        hi = lo + rng.uniform(0, 1.0, 2)
+        r_hi = float(rng.uniform(0.0, 2.0))
+        a, b = m.contract_box(lo, hi, r_hi), oracle_contract(m, lo, hi, r_hi)
+        assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+        w = m.win(lo - 3.0, hi + 3.0)
+        p = m.win(lo, hi)
+        ref = oracle_clearance_cells(m.free, *p, w)
+        assert np.allclose(m.clearance_cells(*p, w), ref, rtol=0, atol=1e-12)
+
+
+def _old_predict(lo, hi, h0l, h0h, dt, yl, yh, cl_, ch_, vl, vh):  # noqa: ANN001, ANN202
+    dn, up = (lambda v: math.nextafter(v, -math.inf)), (lambda v: math.nextafter(v, math.inf))
+
+    def mul(al, ah, bl, bh):  # noqa: ANN001, ANN202
+        p = (al * bl, al * bh, ah * bl, ah * bh)
+        return dn(min(p)), up(max(p))
+
+    dtl, dth = dn(dt), up(dt)
+    wl, wh = mul(dtl, dth, yl, yh)
+    hl, hh = max(cl_, dn(h0l + wl)), min(ch_, up(h0h + wh))
+    zl, zh = min(wl, 0.0), max(wh, 0.0)
+    sl, sh = max(dn(h0l + zl), dn(hl - zh)), min(up(h0h + zh), up(hh - zl))
+    c0, c1, s0, s1 = cos_sin(sl, sh)
+    d = [mul(dtl, dth, *mul(vl, vh, c0, c1)), mul(dtl, dth, *mul(vl, vh, s0, s1))]
+    return hl, hh, dn(lo[0] + d[0][0]), dn(lo[1] + d[1][0]), up(hi[0] + d[0][1]), up(hi[1] + d[1][1])
+
+
+def test_predict_equals_the_scalar_python_step_and_encloses_the_motion() -> None:
+    rng = np.random.default_rng(4)
+    for _ in range(200):
+        lo = rng.uniform(-5, 5, 2)
+        hi = lo + rng.uniform(0, 0.3, 2)
+        h0l = rng.uniform(-7, 7)
+        h0h, dt = h0l + rng.uniform(0, 0.2), rng.uniform(0.01, 0.2)
+        yl = rng.uniform(-1, 1)
+        vl = rng.uniform(-0.2, 1.0)
+        args = (h0l, h0h, dt, yl, yl + 0.05, -np.inf, np.inf, vl, vl + 0.05)
+        ok, hl, hh, x0, y0, x1, y1, *_ = predict(lo[0], lo[1], hi[0], hi[1], *args)
+        assert ok and (hl, hh, x0, y0, x1, y1) == _old_predict(lo, hi, *args)
+        # a constant-rate motion from a pose of the box stays in the predicted box
+        t = np.linspace(0, dt, 9)
+        for _k in range(5):
+            w, v, h = rng.uniform(yl, yl + 0.05), rng.uniform(vl, vl + 0.05), rng.uniform(h0l, h0h)
+            x = lo + (hi - lo) * rng.random(2)
+            ang = h + w * t
+            end = x + v * np.array([np.trapezoid(np.cos(ang), t), np.trapezoid(np.sin(ang), t)])
+            assert x0 - 1e-6 <= end[0] <= x1 + 1e-6 and y0 - 1e-6 <= end[1] <= y1 + 1e-6
+            assert hl <= h + w * dt <= hh
+
+
+def test_a_mission_passes_the_ground_truth_checks() -> None:
+    suite = SensorSuite(np.r_[np.arange(8) * math.pi / 4, 0.0], np.r_[np.full(8, math.pi / 12), math.pi],
+                        np.full(9, 5.0))  # fmt: skip
+    world = ThesisRoom(jitter=0.2).generate(3)
+    rec, truth = loop_mission(
+        world, suite=suite, duration=15.0, noise=NoiseConfig(model="adversarial"), seed=3
+    )
+    grid = Grid.from_cell_size((-10.0, -10.0), (10.0, 10.0), 0.15625)
+    f = OnlineDigSlam(grid)
+    f.reset(truth[0, :2], truth[0, :2], rec[0])
+    rng = np.random.default_rng(0)
+    for k in range(1, len(rec)):
+        f.update(rec[k])
+        assert f.consistent
+        assert np.all((f.pose_lo <= truth[k, :2]) & (truth[k, :2] <= f.pose_hi))
+        assert f.heading_lo <= truth[k, 2] <= f.heading_hi
+        if k % 10 == 0:  # every truly sensed point lies in the explored outer set
+            d = suite.true_ranges(world, truth[k, :3])
+            d = np.where(np.isfinite(d), d, suite.r_max)[:, None] * np.sqrt(rng.random((suite.n, 20)))
+            th = truth[k, 2] + suite.alpha[:, None] + suite.gamma[:, None] * rng.uniform(-1, 1, (suite.n, 20))
+            px, py = (truth[k, 0] + d * np.cos(th)).ravel(), (truth[k, 1] + d * np.sin(th)).ravel()
+            col = np.clip(np.searchsorted(grid.xs, px) - 1, 0, grid.shape[1] - 1)
+            row = np.clip(np.searchsorted(-grid.ys, -py) - 1, 0, grid.shape[0] - 1)
+            assert np.all(f.sensed_maybe[row, col])
+    assert_free(f.dig.free, world, grid, rng, 2000)
+    assert_free(f.clear_mask(), world, grid, rng, 2000)
+    assert f.dig.free.sum() > 100
+
+
+def test_observer_sets_and_map_kernels_match_numpy() -> None:
+    rng = np.random.default_rng(5)
+    sure, maybe, free, reach = (rng.random((40, 40)) < p for p in (0.3, 0.6, 0.7, 0.8))
+    maybe |= sure
+    explored, clear, dark = np.empty((40, 40), np.int8), np.empty((40, 40), bool), np.empty((40, 40), bool)
+    n = observer_sets(sure, maybe, free, reach, explored, clear, dark)
+    ref = np.where(sure, CLEAR, np.where(maybe, PENUMBRA, DARK))
+    assert np.array_equal(explored, ref) and np.array_equal(clear, sure & free)
+    assert np.array_equal(dark, ~maybe) and n == int(np.sum(sure & free & reach))
+    for m in (40, 36, 20, 64):
+        img = np.zeros((3, m, m), np.uint8)
+        fill_map(clear, dark, img)
+        s = (np.arange(m) * 40) // m
+        e = np.maximum(np.append(s[1:], 40), s + 1)
+        c = np.array([[clear[s[i] : e[i], s[j] : e[j]].all() for j in range(m)] for i in range(m)])
+        d = np.array([[dark[s[i] : e[i], s[j] : e[j]].all() for j in range(m)] for i in range(m)])
+        assert np.array_equal(img[0] > 0, c) and np.array_equal(img[2] > 0, d) and np.all(img.sum(0) == 255)
+        assert all(
+            np.array_equal(a, b) for a, b in zip(three_state(clear, dark, m), (c, ~(c | d), d), strict=True)
+        )
+    with pytest.raises(ValueError, match="C-contiguous"):
+        observer_sets(sure, maybe, free, reach, explored, clear[:, ::2], dark)
+
+
+@pytest.mark.parametrize("window", [0, 3])
+def test_wrapper_sets_kept_up_to_date_equal_the_filter_sets(window: int) -> None:
+    from digslam.envs.dig_coverage.maps_jit import three_state as ts
+    from digslam.envs.dig_coverage.wrapper import GuaranteedObserver
+    from digslam.envs.explore.env import ExploreEnv
+    from digslam.observer.online.observer import OnlineConfig
+
+    env = GuaranteedObserver(
+        ExploreEnv(world="rocks"), map_size=48, config=OnlineConfig(smoothing_window=window)
+    )
+    rng = np.random.default_rng(window)
+    for episode in range(2):
+        obs, info = env.reset(seed=episode)
+        for k in range(60):
+            f = env.filter
+            assert np.array_equal(info["explored"], f.explored()) and np.array_equal(
+                info["clear"], f.clear_mask()
+            )
+            assert round(info["certified_coverage"] * env.n_reachable) == np.sum(
+                f.clear_mask() & env.reachable
+            )
+            c, p, d = ts(f.clear_mask(), f.explored() == DARK, 48)
+            assert np.array_equal(obs["map"][0] > 0, c) and np.array_equal(obs["map"][2] > 0, d)
+            if k % 20 == 0:
+                info["clear"][:] = True  # the agent's copies are its own
+            a = np.array([rng.uniform(0.3, 1.0), rng.uniform(-1, 1)], np.float32)
+            obs, _, _, _, info = env.step(a)
+
+
+def test_dig_and_mark_window_holds_every_changed_cell_and_filter_step_matches_the_kernels() -> None:
+    from digslam.observer.online.mark_jit import dig_and_mark
+    from digslam.observer.online.pose_jit import contract, impact_bound
+    from digslam.observer.online.step_jit import filter_step
+
+    g = Grid((-4.0, -4.0), (4.0, 4.0), (64, 64))
+    d = WindowDigMap(g)
+    rng = np.random.default_rng(11)
+    free, sure, maybe = (np.zeros(g.shape, bool) for _ in range(3))
+    alpha = np.array([0.0, 1.0, -2.0, np.pi / 2, 0.0])
+    gamma = np.array([0.3, 0.2, 0.4, 0.26, np.pi])
+    r_max = np.full(5, 3.0)
+    lo, hi, h = np.array([-0.1, -0.2]), np.array([0.1, 0.0]), (-0.05, 0.05)
+    for _ in range(40):
+        rg = np.sort(rng.uniform(0.2, 3.5, (5, 2)), axis=1)
+        no_echo = rg[:, 0] > 3.0
+        rg[no_echo] = [3.0, np.inf]
+        yaw, comp, speed = np.array([-0.3, 0.3]), np.array([h[0] - 0.1, h[1] + 0.1]), np.array([0.4, 0.6])
+        f0, s0, m0 = free.copy(), sure.copy(), maybe.copy()
+        # the fused step equals predict + Eq. 6.22 + dig_and_mark called one by one
+        ok, hl, hh, x0, y0, x1, y1, *disp = predict(lo[0], lo[1], hi[0], hi[1], h[0], h[1], 0.1, *yaw, *comp,
+                                                    *speed)  # fmt: skip
+        assert ok
+        rb = impact_bound(no_echo, rg)
+        if math.isfinite(rb):
+            x0, y0, x1, y1 = contract(f0, d.xs, d.ys, d.nys, x0, y0, x1, y1, rb, *g.cell_size, d.keep, d.off)
+        st = np.empty(10)
+        code, *win = filter_step(free, sure, maybe, d.xs, d.ys, d.nys, d.frame, lo, hi, h[0], h[1], st, 0.1,
+                                 yaw, comp, speed, alpha, gamma, r_max, rg, no_echo, True)  # fmt: skip
+        if not x0 <= x1 or not y0 <= y1:  # the random ranges contradict the dug cells: start again
+            assert code == 1
+            lo, hi, h = np.array([-0.1, -0.2]), np.array([0.1, 0.0]), (-0.05, 0.05)
+            free[:], sure[:], maybe[:] = False, False, False
+            continue
+        assert code == 0 and st.tolist() == [x0, y0, x1, y1, hl, hh, *disp]
+        f1, s1, m1 = f0.copy(), s0.copy(), m0.copy()
+        assert dig_and_mark(f1, s1, m1, d.xs, d.ys, d.nys, x0, y0, x1, y1, hl, hh, alpha, gamma, r_max, rg,
+                            True) == tuple(win)  # fmt: skip
+        assert np.array_equal(f1, free) and np.array_equal(s1, sure) and np.array_equal(m1, maybe)
+        changed = (free != f0) | (sure != s0) | (maybe != m0)
+        r0, r1, c0, c1 = win
+        outside = changed.copy()
+        outside[r0:r1, c0:c1] = False
+        assert not outside.any() and (changed.any() or (r0 >= r1 or c0 >= c1))
+        if changed.any():  # the smallest such window
+            rows, cols = np.nonzero(changed)
+            assert (r0, r1, c0, c1) == (rows.min(), rows.max() + 1, cols.min(), cols.max() + 1)
+        lo, hi, h = st[0:2].copy(), st[2:4].copy(), (st[4], st[5])
+        lo, hi = np.clip(lo, -3.0, 3.0), np.clip(np.maximum(hi, lo), -3.0, 3.0)
+
+
+def test_observe_matches_its_pieces() -> None:
+    from digslam.envs.dig_coverage.maps_jit import observe, pixel_blocks, pixel_range, sets_and_map
+    from digslam.observer.online.dig_jit import window
+
+    rng = np.random.default_rng(6)
+    for n, m in ((40, 36), (30, 64), (64, 64)):
+        g = Grid((-2.0, -2.0), (2.0, 2.0), (n, n))
+        sure, maybe, free, reach = (rng.random((n, n)) < p for p in (0.3, 0.6, 0.7, 0.8))
+        maybe |= sure
+        planes = np.zeros((4, n, n), np.uint8)
+        planes[3] = reach
+        explored, clear, dark = (np.zeros((n, n), t) for t in (np.int8, bool, bool))
+        base, ref_base = np.zeros((3, m, m), np.uint8), np.zeros((3, m, m), np.uint8)
+        lo, hi = np.sort(rng.uniform(-2.0, 2.0, (2, 2)), axis=0)
+        img, state = np.empty((4, m, m), np.uint8), np.empty(11, np.float32)
+        norm = np.array([0.0, 0.0, 2.0, 2.0, 100.0])
+        win = (3, n - 5, 2, n // 2)
+        ref = sets_and_map(sure, maybe, free, reach, explored, clear, dark, ref_base, win)
+        snap = np.empty((3, n, n), np.uint8)
+        got = observe(sure, maybe, free, planes, base, img, win, g.xs, -g.ys, lo, hi, (0.1, 0.3), norm, 7,
+                      int(reach.sum()), 5, state, snap)  # fmt: skip
+        assert np.array_equal(snap[:2], planes[:2]) and np.array_equal(snap[2], free)
+        assert got == ref + 5 and np.array_equal(base, ref_base) and np.array_equal(img[:3], ref_base)
+        assert np.array_equal(planes[0].view(np.int8)[3 : n - 5, 2 : n // 2], explored[3 : n - 5, 2 : n // 2])
+        r0, r1, c0, c1 = window(g.xs, -g.ys, lo[0], lo[1], hi[0], hi[1])
+        p0, p1 = pixel_range(r0, r1, n, m)
+        q0, q1 = pixel_range(c0, c1, n, m)
+        foot = np.zeros((m, m), np.uint8)
+        foot[p0:p1, q0:q1] = 255
+        assert np.array_equal(img[3], foot) and pixel_blocks((n, n), m).shape == (4, m)
+        want = [lo[0] / 2, lo[1] / 2, hi[0] / 2, hi[1] / 2, math.cos(0.2), math.sin(0.2), 0.1 / math.pi,
+                math.tanh(max(hi - lo)), 0.07, (ref + 5) / reach.sum(), 1.0]  # fmt: skip
+        assert np.array_equal(state, np.array(want, np.float32))

@@ -1,0 +1,157 @@
+"""Offline Dig-SLAM (thesis §6.4, Algorithm 6.3): guarantees against the simulator's ground truth."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from ground_truth import assert_free
+
+from digslam.envs.config import NoiseConfig
+from digslam.envs.sim.arc_jit import arc
+from digslam.envs.sim.missions import loop_mission
+from digslam.envs.sim.sensors import SensorSuite
+from digslam.envs.world.generators import ThesisRoom
+from digslam.observer.slam.digslam import DigSlamConfig, dig_slam
+from digslam.observer.slam.grid import Grid
+from digslam.observer.slam.record import MissionRecord
+
+CELL = 0.1
+GRID = Grid.from_cell_size((-10.0, -10.0), (10.0, 10.0), CELL)
+OMNI = SensorSuite(np.array([0.0]), np.array([math.pi]), np.array([10.0]))
+SONARS = SensorSuite(np.array([0.0, math.pi / 2, math.pi, -math.pi / 2]), np.full(4, math.pi / 12),
+                     np.full(4, 4.0))  # fmt: skip
+WORLDS: dict[int, object] = {}  # the world of each mission record, for the ground truth
+BOTH = SensorSuite(np.r_[SONARS.alpha, 0.0], np.r_[SONARS.gamma, math.pi], np.r_[SONARS.r_max, 5.0])
+
+
+def slice_points(truth: np.ndarray, dt: float, n: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """True positions at ``n`` times strictly inside every slice (exact arcs)."""
+    ts, xs = [], []
+    for j in range(1, n + 1):
+        tau = dt * j / (n + 1)
+        p = np.array([arc(truth[k, :3], truth[k, 3], truth[k, 4], tau) for k in range(len(truth) - 1)])
+        ts.append(np.arange(len(truth) - 1) * dt + tau)
+        xs.append(p[:, :2])
+    return np.concatenate(ts), np.concatenate(xs)
+
+
+@pytest.mark.parametrize(
+    ("suite", "model", "seed", "jitter"),
+    [(OMNI, "uniform", 0, 0.0), (OMNI, "adversarial", 1, 0.3), (BOTH, "uniform", 2, 0.2),
+     (SONARS, "adversarial", 3, 0.0), (BOTH, "biased", 4, 0.3)],
+)  # fmt: skip
+def test_guarantees_against_ground_truth(suite, model, seed, jitter):
+    world = ThesisRoom(jitter=jitter).generate(seed)
+    duration = 150.0 if suite is OMNI else 40.0  # sonar sectors cost more to dig
+    rec, truth = loop_mission(
+        world, suite=suite, duration=duration, noise=NoiseConfig(model=model), seed=seed
+    )
+    WORLDS[id(rec)] = world
+    res = dig_slam(rec, GRID, truth[0, :2], truth[0, :2])
+    assert res.consistent and res.first_empty is None
+    tube = res.tube
+    # the true position is in the tube at every time: gates and inside every slice
+    assert np.all((tube.gate_lo <= truth[:, :2]) & (truth[:, :2] <= tube.gate_hi)), "truth left a gate"
+    ts, xs = slice_points(truth, 0.1)
+    assert np.all(tube.contains(ts, xs)), "truth left a slice"
+    assert np.all((tube.slice_lo <= xs[: len(truth) - 1]) & (xs[: len(truth) - 1] <= tube.slice_hi))
+    assert_free(res.dig.free, world, GRID, np.random.default_rng(seed))
+    assert res.dig.free.sum() * CELL**2 > 10.0  # it dug a real area
+    assert_explored_sound(res.explored, rec, truth, suite, np.random.default_rng(seed))
+
+
+def truly_sensed(p: np.ndarray, rec: MissionRecord, truth: np.ndarray, suite: SensorSuite) -> np.ndarray:
+    """Points ``(P, 2)`` inside some true visible set: within the true range, in the true cone."""
+    true_r = np.array([suite.true_ranges(WORLDS[id(rec)], pose) for pose in truth[:, :3]])
+    true_r = np.where(np.isfinite(true_r), true_r, suite.r_max)  # (T, S)
+    d = p[:, None, :] - truth[None, :, :2]  # (P, T, 2)
+    rho = np.linalg.norm(d, axis=-1)
+    ang = np.arctan2(d[..., 1], d[..., 0])
+    seen = np.zeros(p.shape[0], dtype=bool)
+    for s in range(suite.n):
+        diff = np.abs((ang - truth[None, :, 2] - suite.alpha[s] + np.pi) % (2 * np.pi) - np.pi)
+        seen |= ((rho <= true_r[None, :, s]) & (diff <= suite.gamma[s])).any(axis=1)
+    return seen
+
+
+def assert_explored_sound(st: np.ndarray, rec: MissionRecord, truth: np.ndarray, suite: SensorSuite,
+                          rng: np.random.Generator) -> None:  # fmt: skip
+    """Clear cells were truly sensed, dark cells never; every truly sensed point is in a non-dark cell."""
+    from digslam.observer.thick.sep import CLEAR, DARK
+
+    for code, want in ((CLEAR, True), (DARK, False)):
+        rows, cols = np.nonzero(st == code)
+        if rows.size == 0:
+            continue
+        pick = rng.choice(rows.size, min(rows.size, 150), replace=False)
+        lo, hi = GRID.cell_boxes(rows[pick], cols[pick])
+        pts = np.concatenate([lo + (hi - lo) * rng.random(lo.shape), lo, hi])
+        assert np.all(truly_sensed(pts, rec, truth, suite) == want), f"a {code} cell is wrong"
+    # truly sensed points: from random true poses, inside the true cone and range
+    k = rng.integers(0, len(truth), 300)
+    s = rng.integers(0, suite.n, 300)
+    true_r = np.array([suite.true_ranges(WORLDS[id(rec)], truth[i, :3])[j] for i, j in zip(k, s)])
+    rr = np.where(np.isfinite(true_r), true_r, suite.r_max[s]) * rng.random(300)
+    th = truth[k, 2] + suite.alpha[s] + suite.gamma[s] * rng.uniform(-1, 1, 300)
+    p = truth[k, :2] + rr[:, None] * np.c_[np.cos(th), np.sin(th)]
+    inside = np.all((p > GRID.lo) & (p < GRID.hi), axis=1)
+    lo, hi = GRID.cell_boxes()
+    p = p[inside]
+    col = np.searchsorted(GRID.xs, p[:, 0]) - 1
+    row = np.searchsorted(-GRID.ys, -p[:, 1]) - 1
+    assert np.all(st[row, col] != DARK), "a truly sensed point lies in a dark cell"
+
+
+def test_tube_shrinks_relative_to_dead_reckoning():
+    rec, truth = loop_mission(duration=400.0, seed=5)
+    res = dig_slam(rec, GRID, truth[0, :2], truth[0, :2])
+    assert res.consistent
+    final, dr = res.tube.widths(), res.dead_reckoning
+    assert final[-1] < 0.5 * dr[-1]
+    assert np.all(final <= dr + 1e-12)
+    assert len(res.widths) == res.iterations >= 2
+    no_impacts = dig_slam(rec, GRID, truth[0, :2], truth[0, :2], DigSlamConfig(impacts=False))
+    assert np.allclose(no_impacts.tube.widths(), dr)
+
+
+def test_inconsistent_reading_is_reported():
+    world = ThesisRoom().generate(0)
+    rec, truth = loop_mission(world, duration=60.0, seed=6)
+    d = rec.as_dict()
+    rng = d["range"].copy()
+    k = 300
+    rng[k, 0] = rng[k, 0] + 3.0  # reported 3 m farther than the truth: contradicts the neighbours
+    d["range"] = rng
+    bad = MissionRecord(**d)
+    res = dig_slam(bad, GRID, truth[0, :2], truth[0, :2])
+    assert not res.consistent
+    assert res.first_empty is not None and res.tube is None and res.dig is None
+
+
+def test_record_round_trip_gives_the_same_result(tmp_path):
+    rec, truth = loop_mission(duration=30.0, seed=7)
+    rec.save_npz(tmp_path / "mission.npz")
+    again = MissionRecord.load_npz(tmp_path / "mission.npz")
+    a = dig_slam(rec, GRID, truth[0, :2], truth[0, :2])
+    b = dig_slam(again, GRID, truth[0, :2], truth[0, :2])
+    assert np.array_equal(a.tube.gate_lo, b.tube.gate_lo) and np.array_equal(a.dig.free, b.dig.free)
+
+
+def test_bad_input():
+    rec, truth = loop_mission(duration=2.0, seed=0)
+    with pytest.raises(ValueError, match="x0_lo"):
+        dig_slam(rec, GRID, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    with pytest.raises(ValueError, match="x0_lo"):
+        dig_slam(rec, GRID, [1.0, 0.0], [0.0, 0.0])
+    with pytest.raises(ValueError, match="record"):
+        dig_slam(rec[0], GRID, [0.0, 0.0], [0.0, 0.0])
+    with pytest.raises(ValueError, match="max_iter"):
+        DigSlamConfig(max_iter=0)
+    with pytest.raises(ValueError, match="unknown"):
+        DigSlamConfig.from_dict({"max_iters": 3})
+    d = rec.as_dict()
+    d["range"] = d["range"][:, :, ::-1].copy()
+    with pytest.raises(ValueError, match="range"):
+        MissionRecord(**d)
