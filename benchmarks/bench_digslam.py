@@ -16,8 +16,8 @@ import time
 
 import numpy as np
 
+from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.missions import loop_mission
-from digslam.envs.world.generators import ThesisRoom
 from digslam.observer.slam.digslam import dig_slam
 from digslam.observer.slam.grid import Grid
 

@@ -15,9 +15,9 @@ import gymnasium as gym
 
 from digslam.envs.config import ExploreConfig, NoiseConfig
 from digslam.envs.explore.env import ExploreEnv
-from digslam.envs.explore.episode import Episode, GroundTruth, record_episode, replay
-from digslam.envs.sim.sensors import SensorSuite
-from digslam.envs.world.generators import (
+from digslam.envs.explore.episode import Episode, record_episode, replay
+from digslam.envs.explore.truth import GroundTruth
+from digslam.envs.sim.generators import (
     Caves,
     FileMap,
     RockField,
@@ -25,7 +25,8 @@ from digslam.envs.world.generators import (
     ThesisRoom,
     WorldGenerator,
 )
-from digslam.envs.world.world import World
+from digslam.envs.sim.sensors import SensorSuite
+from digslam.envs.sim.world import World
 from digslam.observer.core import compat as _compat
 from digslam.observer.core import origin as _origin  # a shadowing source folder is reported in one line
 
@@ -33,11 +34,11 @@ _origin.warn_if_shadowed(__name__)
 
 #: Modules that moved into the concept folders: old name -> new path (the old path warns, for one release).
 MOVED = {
-    "geometry": "world.geometry", "geometry_jit": "world.geometry_jit", "raster": "world.raster",
-    "tracing": "world.tracing", "generators": "world.generators", "render": "world.render",
+    "geometry": "sim.geometry", "geometry_jit": "sim.geometry_jit", "raster": "sim.raster",
+    "tracing": "sim.tracing", "generators": "sim.generators", "render": "sim.render",
     "arc": "sim.arc_jit", "robot": "sim.robot", "robot_jit": "sim.robot_jit", "sensors": "sim.sensors",
-    "noise": "sim.noise", "noise_jit": "sim.noise_jit", "coverage": "sim.coverage",
-    "coverage_jit": "sim.coverage_jit", "missions": "sim.missions", "explore_env": "explore.env",
+    "noise": "sim.noise", "noise_jit": "sim.noise_jit", "coverage": "explore.coverage",
+    "coverage_jit": "explore.coverage_jit", "missions": "sim.missions", "explore_env": "explore.env",
     "episode": "explore.episode", "observer_config": "dig_coverage.config",
     "observer_wrapper": "dig_coverage.wrapper", "observer_maps": "dig_coverage.maps_jit",
     "monitor": "dig_coverage.monitor",

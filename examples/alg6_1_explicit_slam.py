@@ -30,11 +30,11 @@ from pathlib import Path
 import numpy as np
 
 from digslam.envs.config import NoiseConfig
+from digslam.envs.sim.generators import RockField
 from digslam.envs.sim.missions import loop_mission
+from digslam.envs.sim.raster import FREE, OCCUPIED
 from digslam.envs.sim.sensors import SensorSuite
-from digslam.envs.world.generators import RockField
-from digslam.envs.world.raster import FREE, OCCUPIED
-from digslam.envs.world.world import World
+from digslam.envs.sim.world import World
 from digslam.observer.slam.explicit_slam import (
     ExplicitSlamConfig,
     ExplicitSlamResult,

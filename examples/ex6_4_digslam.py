@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.missions import loop_mission
-from digslam.envs.world.generators import ThesisRoom
 from digslam.observer.slam.digslam import DigSlamResult, dig_slam
 from digslam.observer.slam.grid import Grid
 

@@ -11,7 +11,11 @@ import pytest
 
 import digslam.observer as observer
 
-MODULES = sorted(m.name for m in pkgutil.iter_modules(observer.__path__) if not m.name.startswith("_"))
+MODULES = sorted(
+    m.name.removeprefix("digslam.observer.")
+    for m in pkgutil.walk_packages(observer.__path__, "digslam.observer.")
+    if not m.name.rsplit(".", 1)[-1].startswith("_")
+)
 
 
 @pytest.mark.parametrize("name", MODULES)

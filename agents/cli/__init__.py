@@ -5,3 +5,7 @@ warmup...) and :mod:`.warmup` (compiling every kernel once).
 
 May import: everything in :mod:`digslam`.
 """
+
+from .main import main
+
+__all__ = ["main"]

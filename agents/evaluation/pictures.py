@@ -70,7 +70,7 @@ class FrameDrawer:
     def __init__(self, layer: Any, title: str, target: float | None, steps: int) -> None:
         from PIL import Image, ImageDraw
 
-        from digslam.envs.world.raster import FREE, rasterize
+        from digslam.envs.sim.raster import FREE, rasterize
 
         self.layer, self.title, self.target, self.steps = layer, title, target, steps
         g = layer.grid

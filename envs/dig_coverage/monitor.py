@@ -15,7 +15,7 @@ record and truth:
 
 Once the filter reports an inconsistency its claims are withdrawn, so nothing more is checked.
 
->>> from digslam.envs.world.world import World
+>>> from digslam.envs.sim.world import World
 >>> from digslam.observer.slam.grid import Grid
 >>> sq = np.array([(-2.0, -2.0), (2.0, -2.0), (2.0, 2.0), (-2.0, 2.0)])
 >>> m = GuaranteeMonitor(World((-2, -2, 2, 2), [sq]), Grid((-2.0, -2.0), (2.0, 2.0), (4, 4)))
@@ -30,8 +30,8 @@ from typing import Any
 
 import numpy as np
 
-from digslam.envs.world import geometry as geo
-from digslam.envs.world.world import World
+from digslam.envs.sim import geometry as geo
+from digslam.envs.sim.world import World
 from digslam.observer.slam.grid import Grid
 from digslam.observer.thick.sep import DARK
 

@@ -73,9 +73,9 @@ from scipy import ndimage
 from digslam.envs.dig_coverage.config import ObserverConfig
 from digslam.envs.dig_coverage.maps_jit import _observe, crop_window, fill_map, pixel_blocks
 from digslam.envs.dig_coverage.monitor import GuaranteeMonitor
-from digslam.envs.sim.coverage import Coverage
-from digslam.envs.world.raster import FREE, rasterize
-from digslam.envs.world.world import World
+from digslam.envs.explore.coverage import Coverage
+from digslam.envs.sim.raster import FREE, rasterize
+from digslam.envs.sim.world import World
 from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam
 from digslam.observer.slam.grid import Grid
 from digslam.observer.slam.record import MissionRecord

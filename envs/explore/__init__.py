@@ -1,26 +1,43 @@
-"""The raw Gymnasium family ``digslam/Explore-*``: the simulator as an environment.
+"""The raw Gymnasium family ``digslam/Explore-*``: the simulator as an environment, with ground truth.
 
-Lives here: :mod:`.env` (``ExploreEnv``) and :mod:`.episode` (``Episode``, ``GroundTruth``, recording and
-replaying an episode).
+Lives here: :mod:`.env` (``ExploreEnv``), :mod:`.coverage` and :mod:`.coverage_jit` (the ground-truth
+coverage: which cells the sensors truly swept), :mod:`.truth` (``GroundTruth``) and :mod:`.episode`
+(``Episode``, recording and replaying an episode).
 
-May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.slam`, :mod:`digslam.envs.world`,
-:mod:`digslam.envs.sim`, :mod:`digslam.envs.config`; gymnasium, numpy.
+May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.slam.record`, :mod:`digslam.envs.sim`,
+:mod:`digslam.envs.config`; gymnasium, numpy.
 """
 
+from .coverage import (
+    Coverage,
+)
+from .coverage_jit import (
+    NB,
+    cover_kernel,
+    cover_update,
+    pseudo_angle,
+)
 from .env import (
     ExploreEnv,
 )
 from .episode import (
     Episode,
-    GroundTruth,
     record_episode,
     replay,
 )
+from .truth import (
+    GroundTruth,
+)
 
 __all__ = [
+    "Coverage",
     "Episode",
     "ExploreEnv",
     "GroundTruth",
+    "NB",
+    "cover_kernel",
+    "cover_update",
+    "pseudo_angle",
     "record_episode",
     "replay",
 ]

@@ -34,14 +34,14 @@ import numpy as np
 from gymnasium import spaces
 
 from digslam.envs.config import ExploreConfig
-from digslam.envs.explore.episode import GroundTruth
+from digslam.envs.explore.coverage import Coverage
+from digslam.envs.explore.truth import GroundTruth
 from digslam.envs.sim.arc_jit import exact_duration
-from digslam.envs.sim.coverage import Coverage
+from digslam.envs.sim.generators import GENERATORS, WorldGenerator
 from digslam.envs.sim.noise_jit import obs_kernel
 from digslam.envs.sim.robot import RobotSim
 from digslam.envs.sim.sensors import SensorSuite, measure_step
-from digslam.envs.world.generators import GENERATORS, WorldGenerator
-from digslam.envs.world.world import World
+from digslam.envs.sim.world import World
 from digslam.observer.slam.record import MissionRecord
 
 
@@ -168,7 +168,7 @@ class ExploreEnv(gym.Env):
             gym.logger.warn("render: no render_mode was given at construction")
             return None
         if self._renderer is None:
-            from digslam.envs.world.render import Renderer
+            from digslam.envs.sim.render import Renderer
 
             self._renderer = Renderer(self.render_mode, self.metadata["render_fps"])
         return self._renderer.draw(self)

@@ -1,13 +1,15 @@
-"""The simulated robot and its sensors: from actions to a bounded mission record.
+"""The simulator: unstructured 2-D worlds, the robot that moves in them, and its bounded sensors.
 
-Lives here: :mod:`.arc_jit` (the exact arc of one piece of motion and its proved error bound),
-:mod:`.robot` (``RobotSim``) and :mod:`.robot_jit`, :mod:`.sensors` (``SensorSuite``: sonars, omnidirectional
-range, odometry, compass), :mod:`.noise` and :mod:`.noise_jit` (bounded noise models, outliers),
-:mod:`.coverage` and :mod:`.coverage_jit` (ground-truth coverage) and :mod:`.missions` (the thesis's missions
-as records).
+Lives here, in data-flow order: :mod:`.world` (``World``: polygonal obstacles and a raster), :mod:`.tracing`
+(marching squares), :mod:`.raster`, :mod:`.generators` (``ThesisRoom``, ``RockField``, ``Caves``,
+``RoomsCorridors``, ``FileMap``), :mod:`.geometry` and :mod:`.geometry_jit` (rigorous point-edge and sector
+distances), :mod:`.arc_jit` (the exact arc of one piece of motion and its proved error bound),
+:mod:`.robot` and :mod:`.robot_jit` (``RobotSim``), :mod:`.sensors` (``SensorSuite``: sonars,
+omnidirectional range, odometry, compass), :mod:`.noise` and :mod:`.noise_jit` (bounded noise, outliers),
+:mod:`.missions` (the thesis's missions as records) and :mod:`.render` (pictures).
 
-May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.slam` (the record),
-:mod:`digslam.envs.world`, :mod:`digslam.envs.config`; numpy, pymunk.
+May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.slam.record`, :mod:`digslam.envs.config`;
+numpy, scipy, pymunk, pygame (on use). No gymnasium.
 """
 
 from .arc_jit import (
@@ -18,14 +20,29 @@ from .arc_jit import (
     exact_duration,
     yaw_rate_bounds,
 )
-from .coverage import (
-    Coverage,
+from .generators import (
+    GENERATORS,
+    THESIS_ROOM,
+    Caves,
+    FileMap,
+    RockField,
+    RoomsCorridors,
+    ThesisRoom,
+    WorldGenerator,
 )
-from .coverage_jit import (
-    NB,
-    cover_kernel,
-    cover_update,
-    pseudo_angle,
+from .geometry import (
+    Edges,
+    edge_bboxes,
+    point_edge_distance,
+    point_free,
+    rings_to_edges,
+    sector_distance,
+)
+from .geometry_jit import (
+    edge_boxes,
+    points_edges_kernel,
+    sector_bounds_kernel,
+    sector_kernel,
 )
 from .missions import (
     THESIS_LOOP,
@@ -40,6 +57,16 @@ from .noise_jit import (
     noise_kernel,
     obs_kernel,
     record_kernel,
+)
+from .raster import (
+    cell_centres,
+    grid_shape,
+    rasterize,
+)
+from .render import (
+    FREE,
+    MIXED,
+    Renderer,
 )
 from .robot import (
     FRACTIONS,
@@ -56,34 +83,67 @@ from .sensors import (
     SensorSuite,
     measure_step,
 )
+from .tracing import (
+    chain_rings,
+    marching_squares,
+    mask_edges,
+    smooth_noise,
+)
+from .world import (
+    World,
+)
 
 __all__ = [
-    "Coverage",
+    "Caves",
+    "Edges",
     "FRACTIONS",
+    "FREE",
+    "FileMap",
+    "GENERATORS",
     "Hull",
+    "MIXED",
     "MODEL_CODES",
-    "NB",
     "ROBOT_TYPE",
+    "Renderer",
     "RobotSim",
+    "RockField",
+    "RoomsCorridors",
     "SWEEP_POINTS",
     "SensorSuite",
     "THESIS_LOOP",
+    "THESIS_ROOM",
+    "ThesisRoom",
     "WALL_TYPE",
+    "World",
+    "WorldGenerator",
     "advance",
     "arc",
     "arc_bounded",
     "arc_move",
-    "cover_kernel",
-    "cover_update",
+    "cell_centres",
+    "chain_rings",
+    "edge_bboxes",
+    "edge_boxes",
     "exact_duration",
+    "grid_shape",
     "loop_mission",
+    "marching_squares",
+    "mask_edges",
     "measure",
     "measure_step",
     "noise_kernel",
     "obs_kernel",
     "outliers",
-    "pseudo_angle",
+    "point_edge_distance",
+    "point_free",
+    "points_edges_kernel",
+    "rasterize",
     "record_kernel",
+    "rings_to_edges",
     "robot_step_kernel",
+    "sector_bounds_kernel",
+    "sector_distance",
+    "sector_kernel",
+    "smooth_noise",
     "yaw_rate_bounds",
 ]

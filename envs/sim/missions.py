@@ -31,9 +31,9 @@ import numpy as np
 
 from digslam.envs.config import NoiseConfig
 from digslam.envs.sim.arc_jit import arc_bounded, exact_duration, yaw_rate_bounds
+from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.sensors import SensorSuite, measure_step
-from digslam.envs.world.generators import ThesisRoom
-from digslam.envs.world.world import World
+from digslam.envs.sim.world import World
 from digslam.observer.slam.record import MissionRecord
 
 #: A loop of waypoints inside the thesis room of Fig. 6.10 (at least 1.3 m from every wall).

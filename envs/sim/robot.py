@@ -24,9 +24,9 @@ import math
 import numpy as np
 import pymunk
 
+from digslam.envs.sim import geometry_jit as gjit
 from digslam.envs.sim.robot_jit import robot_step_kernel
-from digslam.envs.world import geometry_jit as gjit
-from digslam.envs.world.world import World
+from digslam.envs.sim.world import World
 
 ROBOT_TYPE, WALL_TYPE = 1, 2
 #: Fractions of the commanded speed tried, in order, when a substep's sweep is blocked.

@@ -14,7 +14,7 @@ clear without checking the arc.
 Example (1 m/s for 4 substeps of 0.025 s at a wall 0.25 m ahead of a disc of radius 0.2: two substeps
 run, then the disc touches the wall and stops):
     >>> import numpy as np
-    >>> from digslam.envs.world.geometry_jit import edge_boxes
+    >>> from digslam.envs.sim.geometry_jit import edge_boxes
     >>> edges, pose, fractions = np.array([[0.25, -1.0, 0.25, 1.0]]), np.zeros(3), np.array([0.5, 0.25])
     >>> pieces = np.empty((2, 3))
     >>> first, vi, err, w_lo, w_hi = robot_step_kernel(pose, 1.0, 0.0, 0.1, 4, 4, 0.2, edges,
@@ -30,7 +30,7 @@ import math
 import numpy as np
 
 from digslam.envs.sim.arc_jit import advance, yaw_rate_bounds
-from digslam.envs.world.geometry_jit import _near, _seg_dist
+from digslam.envs.sim.geometry_jit import _near, _seg_dist
 from digslam.observer.core.scalar_jit import add_up, njit
 
 

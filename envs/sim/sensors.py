@@ -20,10 +20,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from digslam.envs.config import ExploreConfig, NoiseConfig
+from digslam.envs.sim import geometry_jit as gjit
 from digslam.envs.sim.noise import outliers
 from digslam.envs.sim.noise_jit import MODEL_CODES, record_kernel
-from digslam.envs.world import geometry_jit as gjit
-from digslam.envs.world.world import World
+from digslam.envs.sim.world import World
 from digslam.observer.slam.record import MissionRecord
 
 Hull = float | tuple[float, float]

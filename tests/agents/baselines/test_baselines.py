@@ -215,7 +215,16 @@ def test_frontier_proves_more_than_random_and_keeps_the_tube_narrow() -> None:
     assert res["frontier"][1] < 0.06 and res["frontier"][2] == 0  # straight lines, no bump
 
 
-@pytest.mark.parametrize("module", ["planning", "policy", "frontier", "baselines", "evaluate"])
+@pytest.mark.parametrize(
+    "module",
+    [
+        "baselines.planning",
+        "baselines.policy",
+        "baselines.frontier",
+        "baselines.registry",
+        "evaluation.evaluate",
+    ],
+)
 def test_module_doctests(module: str) -> None:
     import doctest
     import importlib

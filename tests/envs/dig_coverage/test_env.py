@@ -208,7 +208,14 @@ def test_render_uses_the_colour_blind_safe_palette() -> None:
 
 
 @pytest.mark.parametrize(
-    "module", ["observer_maps", "monitor", "observer_config", "observer_wrapper", "dig_coverage"]
+    "module",
+    [
+        "dig_coverage.maps_jit",
+        "dig_coverage.monitor",
+        "dig_coverage.config",
+        "dig_coverage.wrapper",
+        "dig_coverage.env",
+    ],
 )
 def test_module_doctests(module: str) -> None:
     import doctest

@@ -210,7 +210,7 @@ def test_the_auditor_catches_false_claims(what: str) -> None:
 def test_coverage_on_cells_matches_brute_force() -> None:
     """The ground truth over a given set of cells (non-square ones too): a cell counts when its centre lies
     strictly inside a sensed sector."""
-    from digslam.envs.sim.coverage import Coverage
+    from digslam.envs.explore.coverage import Coverage
     from digslam.envs.sim.sensors import SensorSuite
 
     ny, nx, dx, dy = 30, 40, 0.1, 0.15

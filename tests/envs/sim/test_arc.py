@@ -17,9 +17,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from digslam.envs.sim.arc_jit import advance, arc_bounded, exact_duration, yaw_rate_bounds
+from digslam.envs.sim.geometry_jit import edge_boxes, sector_bounds_kernel
 from digslam.envs.sim.robot import RobotSim
-from digslam.envs.world.geometry_jit import edge_boxes, sector_bounds_kernel
-from digslam.envs.world.world import World
+from digslam.envs.sim.world import World
 
 mp.mp.prec = 200
 

@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 
 from digslam.envs import ExploreConfig, NoiseConfig, RockField, SensorSuite, World
+from digslam.envs.explore.coverage import Coverage
+from digslam.envs.sim import geometry as geo
 from digslam.envs.sim.arc_jit import arc
-from digslam.envs.sim.coverage import Coverage
 from digslam.envs.sim.robot import FRACTIONS, SWEEP_POINTS, RobotSim
 from digslam.envs.sim.sensors import measure_step
-from digslam.envs.world import geometry as geo
 from digslam.observer.slam.record import MissionRecord
 
 
@@ -262,7 +262,9 @@ def test_noise_and_record_match_numpy_oracle(model: str) -> None:
         measure_step(0.0, suite, np.ones(suite.n), 0.0, 0.0, math.nan, cfg, rng)
 
 
-@pytest.mark.parametrize("name", ["arc", "geometry_jit", "robot_jit", "coverage_jit", "noise_jit"])
+@pytest.mark.parametrize(
+    "name", ["sim.arc_jit", "sim.geometry_jit", "sim.robot_jit", "explore.coverage_jit", "sim.noise_jit"]
+)
 def test_kernel_module_doctests(name: str) -> None:
     import doctest
     import importlib

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from digslam.envs import ExploreConfig, SensorSuite, World
-from digslam.envs.world import geometry as geo
+from digslam.envs.sim import geometry as geo
 
 N_SAMPLES = 4001
 

@@ -18,9 +18,9 @@ from ground_truth import assert_free
 
 from digslam.envs.config import NoiseConfig
 from digslam.envs.dig_coverage.maps_jit import fill_map, observer_sets, three_state
+from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.missions import loop_mission
 from digslam.envs.sim.sensors import SensorSuite
-from digslam.envs.world.generators import ThesisRoom
 from digslam.observer.core import rounding as rnd
 from digslam.observer.online.observer import OnlineDigSlam
 from digslam.observer.online.pose_jit import cos_sin, predict

@@ -9,9 +9,9 @@ import pytest
 from ground_truth import assert_free
 
 from digslam.envs.config import NoiseConfig
+from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.missions import loop_mission
 from digslam.envs.sim.sensors import SensorSuite
-from digslam.envs.world.generators import ThesisRoom
 from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam, _cos_sin
 from digslam.observer.online.window import WindowDigMap, mark_possibly_sensed
 from digslam.observer.slam.digmap import DigMap

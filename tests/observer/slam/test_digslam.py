@@ -10,9 +10,9 @@ from ground_truth import assert_free
 
 from digslam.envs.config import NoiseConfig
 from digslam.envs.sim.arc_jit import arc
+from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.missions import loop_mission
 from digslam.envs.sim.sensors import SensorSuite
-from digslam.envs.world.generators import ThesisRoom
 from digslam.observer.slam.digslam import DigSlamConfig, dig_slam
 from digslam.observer.slam.grid import Grid
 from digslam.observer.slam.record import MissionRecord

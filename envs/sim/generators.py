@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from digslam.envs.world.tracing import marching_squares, mask_edges, smooth_noise
-from digslam.envs.world.world import World
+from digslam.envs.sim.tracing import marching_squares, mask_edges, smooth_noise
+from digslam.envs.sim.world import World
 
 # Thesis Fig. 6.10: a polygonal room in the frame [-10, 10]^2 made of segments (shape redrawn, not traced).
 THESIS_ROOM = np.array(

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from digslam.envs.world import geometry_jit as jit
+from digslam.envs.sim import geometry_jit as jit
 
 Edges = np.ndarray  # (E, 4) float64
 

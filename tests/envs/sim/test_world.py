@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from digslam.envs import Caves, FileMap, RockField, RoomsCorridors, ThesisRoom, World
-from digslam.envs.world.raster import FREE, MIXED, OCCUPIED, cell_centres, rasterize
+from digslam.envs.sim.raster import FREE, MIXED, OCCUPIED, cell_centres, rasterize
 
 GENERATORS = [ThesisRoom(), RockField(n=20), Caves(), RoomsCorridors()]
 
@@ -125,7 +125,7 @@ def test_traced_contours_are_closed(gen: object) -> None:
 
 @pytest.mark.parametrize("seed", range(4))
 def test_traced_caves_chain_into_rings(seed: int) -> None:
-    from digslam.envs.world.geometry import point_free, rings_to_edges
+    from digslam.envs.sim.geometry import point_free, rings_to_edges
 
     w = Caves().generate(seed)
     assert w.rings and sum(len(r) for r in w.rings) == len(w.edges)

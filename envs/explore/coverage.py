@@ -23,10 +23,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from digslam.envs.sim.coverage_jit import cover_update
+from digslam.envs.explore.coverage_jit import cover_update
+from digslam.envs.sim.raster import FREE
 from digslam.envs.sim.sensors import SensorSuite
-from digslam.envs.world.raster import FREE
-from digslam.envs.world.world import World
+from digslam.envs.sim.world import World
 
 
 class Coverage:

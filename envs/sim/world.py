@@ -13,9 +13,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from digslam.envs.world import geometry as geo
-from digslam.envs.world.raster import rasterize
-from digslam.envs.world.tracing import chain_rings
+from digslam.envs.sim import geometry as geo
+from digslam.envs.sim.raster import rasterize
+from digslam.envs.sim.tracing import chain_rings
 
 
 @dataclass(eq=False)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from digslam.envs import ExploreConfig, RockField, SensorSuite
-from digslam.envs.sim.coverage import Coverage
+from digslam.envs.explore.coverage import Coverage
 
 
 def _reference_hits(cov: Coverage, pose: np.ndarray, suite: SensorSuite, ranges: np.ndarray) -> np.ndarray:

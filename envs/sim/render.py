@@ -14,7 +14,7 @@ import numpy as np
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 import pygame  # noqa: E402
 
-from digslam.envs.world.raster import FREE, MIXED
+from digslam.envs.sim.raster import FREE, MIXED
 
 SIZE = 512
 _COLOURS = np.array([[250, 250, 250], [60, 60, 70], [150, 150, 160]], dtype=np.uint8)  # free, occupied, mixed
