@@ -41,7 +41,7 @@ _LAZY = {
     "EvalResult": "evaluation.evaluate",
     "coverage_figure": "evaluation.evaluate",
     "evaluate_agents": "evaluation.evaluate",
-    "record_episode_gif": "evaluation.evaluate",
+    "record_episode_gif": "evaluation.pictures",
 }
 
 

@@ -1,12 +1,16 @@
 """Steps per second of ``digslam/Explore-v0`` (exact cones) against a pymunk ray-casting reference loop.
 
 Both run the same 30-rock world, 8 sonar cones plus the omnidirectional sensor, dt = 0.1 s with 4 substeps
-and the same random actions. The reference casts 5 rays per cone with ``Space.segment_query_first`` and gets
-the omni range from ``Space.point_query_nearest``; it has no noise, no record, no reward. Ours computes the
-exact cone distances, the noisy intervals, the mission record, the ground truth and the coverage reward, and
-is stepped through ``gym.make``'s wrappers (order enforcing, passive env checker; the reference has none),
-so the ratio is conservative; the unwrapped rate is printed too. Both are timed warm (one untimed run of
-each first, which also loads the compiled kernels).
+and the same random actions, and both move the robot with pymunk (the env's default dynamics: the same
+space, bodies and joints). The reference steps the space and casts 5 rays per cone with
+``Space.segment_query_first`` and gets the omni range from ``Space.point_query_nearest``; it has no noise,
+no record, no reward. Ours also checks the premise after every substep, bounds the body-frame velocity and
+yaw rate over the step, and computes the exact cone distances, the noisy intervals, the mission record, the
+ground truth and the coverage reward, and is stepped through ``gym.make``'s wrappers (order enforcing,
+passive env checker; the reference has none), so the ratio is conservative; the unwrapped rate is printed
+too. The same env with the exact unicycle dynamics (``dynamics="unicycle"``) is timed beside it (keys
+ending in ``_unicycle``). All are timed warm (one untimed run of each first, which also loads the compiled
+kernels), the repeats alternating between them.
 
 Usage: ``python benchmarks/bench_env.py [--steps N] [--repeats R]``. The last line is
 ``ratio_vs_raycast=<ours / reference>`` (median of the repeats, wall-clock time).
@@ -28,11 +32,10 @@ from digslam.envs.sim.robot import RobotSim
 RAYS_PER_CONE = 5
 
 
-def make_ours() -> gym.Env:
+def make_ours(dynamics: str = "pymunk") -> gym.Env:
     """The benchmarked environment: the rock field of 30 obstacles, 8 cones + omni."""
-    return gym.make(
-        "digslam/Explore-v0", world="rocks", n_obstacles=30, n_sonars=8, omni=True, dt=0.1, substeps=4
-    )
+    return gym.make("digslam/Explore-v0", world="rocks", n_obstacles=30, n_sonars=8, omni=True, dt=0.1,
+                    substeps=4, dynamics=dynamics)  # fmt: skip
 
 
 def run_ours(env: gym.Env, actions: np.ndarray) -> float:
@@ -49,7 +52,8 @@ def run_reference(env: gym.Env, actions: np.ndarray) -> float:
     u = env.unwrapped
     env.reset(seed=0)
     cfg, suite = u.config, u.suite
-    sim = RobotSim(u.world, cfg.robot_radius, u.sim.pose, cfg.max_force, cfg.max_torque)
+    skin = 1.5 * cfg.max_speed * cfg.dt / cfg.substeps  # the env's collision skin
+    sim = RobotSim(u.world, cfg.robot_radius, u.sim.pose, cfg.max_force, cfg.max_torque, skin)
     space, body = sim.space, sim.body
     filt = pymunk.ShapeFilter(group=1)
     sim.shape.filter = filt
@@ -110,7 +114,7 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=2000)
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args()
-    env = make_ours()
+    env, uni = make_ours(), make_ours("unicycle")
     rng = np.random.default_rng(0)
     actions = np.column_stack([rng.uniform(0.3, 1.0, args.steps), rng.uniform(-1, 1, args.steps)])
     actions = actions.astype(np.float32)
@@ -119,13 +123,16 @@ def main() -> None:
     # Warm-up, untimed: loads the compiled kernels (numba's on-disk cache) and lets gymnasium's passive env
     # checker see its first step; then both loops run warm, on the same world and actions.
     run_ours(env, actions[:50])
+    run_ours(uni, actions[:50])
     run_reference(env, actions[:50])
-    ours, ref, raw = [], [], []
+    ours, ref, raw, ours_u, raw_u = [], [], [], [], []
     for _ in range(args.repeats):
         ours.append(args.steps / run_ours(env, actions))
+        ours_u.append(args.steps / run_ours(uni, actions))
         ref.append(args.steps / run_reference(env, actions))
         raw.append(args.steps / run_ours(env.unwrapped, actions))
-    o, r = float(np.median(ours)), float(np.median(ref))
+        raw_u.append(args.steps / run_ours(uni.unwrapped, actions))
+    o, r, o_u = float(np.median(ours)), float(np.median(ref)), float(np.median(ours_u))
     s_ours, s_ref = sensing_only(env, args.steps)
     print(
         f"world: rocks, 30 obstacles, {n_edges} edges; 8 cones + omni; dt=0.1 s, 4 substeps; "
@@ -137,6 +144,9 @@ def main() -> None:
     print(
         f"ours_unwrapped_steps_per_s={float(np.median(raw)):.0f}  (the same env without gym.make's wrappers)"
     )
+    print(f"ours_steps_per_s_unicycle={o_u:.0f}  ours_unwrapped_steps_per_s_unicycle={float(np.median(raw_u)):.0f}"
+          "  (exact unicycle dynamics)")  # fmt: skip
+    print(f"hard_stops={env.unwrapped.sim.stops}  (premise guard, last episode)")
     print(
         f"reference_steps_per_s={r:.0f}  "
         f"(pymunk, {RAYS_PER_CONE} rays/cone segment_query_first + omni nearest)"
@@ -144,6 +154,7 @@ def main() -> None:
     print(
         f"sensing_only: exact_cones_per_s={s_ours:.0f} ray_fan_per_s={s_ref:.0f} ratio={s_ours / s_ref:.3f}"
     )
+    print(f"ratio_vs_raycast_unicycle={o_u / r:.3f}")
     print(f"ratio_vs_raycast={o / r:.3f}")
 
 

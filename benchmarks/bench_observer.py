@@ -19,6 +19,10 @@ prove it free), on the same actions and seeds, the three envs alternating chunk 
 figures end in ``_q1``, and ``observed_q1_over_q0`` is the ratio of the observed step rates (the issue's
 bound: at least 0.9).
 
+The envs move the robot with pymunk, the default dynamics (the record then bounds a lateral velocity too,
+and the filter's tube grows with it). The same pair (raw, observed at ``q = 0``) with the exact unicycle
+dynamics runs afterwards on the same actions and seeds; its figures end in ``_unicycle``.
+
 Usage: ``python benchmarks/bench_observer.py [--steps N] [--episode K] [--chunk C]``. Last line:
 ``observer_overhead=<raw steps per second / observed steps per second>`` (``q = 0``).
 """
@@ -85,14 +89,22 @@ def main() -> None:
     rng = np.random.default_rng(0)
     actions = np.column_stack([rng.uniform(0.2, 1.0, args.steps), rng.uniform(-1, 1, args.steps)])
     actions = actions.astype(np.float32)
-    raw = gym.make("digslam/Explore-v0", max_episode_steps=args.episode + 1)
-    obs = gym.make("digslam/DigCoverage-v0", max_episode_steps=args.episode + 1, target=1.0)
-    obs1 = gym.make("digslam/DigCoverage-v0", max_episode_steps=args.episode + 1, target=1.0, q=1)
+    steps = args.episode + 1
+    raw = gym.make("digslam/Explore-v0", max_episode_steps=steps)
+    obs = gym.make("digslam/DigCoverage-v0", max_episode_steps=steps, target=1.0)
+    obs1 = gym.make("digslam/DigCoverage-v0", max_episode_steps=steps, target=1.0, q=1)
     run_pair(raw, [obs, obs1], actions[:50], 50, 50, [[], []])  # warm-up
     probes: list[list[float]] = [[], []]
     t_raw, t_obs, t_obs1 = run_pair(raw, [obs, obs1], actions, args.episode, args.chunk, probes)
     up, up1 = np.array(probes[0]), np.array(probes[1])
     raw_sps, obs_sps, obs1_sps = args.steps / t_raw, args.steps / t_obs, args.steps / t_obs1
+    raw_u = gym.make("digslam/Explore-v0", max_episode_steps=steps, dynamics="unicycle")
+    obs_u = gym.make("digslam/DigCoverage-v0", max_episode_steps=steps, target=1.0, dynamics="unicycle")
+    run_pair(raw_u, [obs_u], actions[:50], 50, 50, [[]])  # warm-up
+    probe_u: list[list[float]] = [[]]
+    t_raw_u, t_obs_u = run_pair(raw_u, [obs_u], actions, args.episode, args.chunk, probe_u)
+    up_u = np.array(probe_u[0])
+    raw_sps_u, obs_sps_u = args.steps / t_raw_u, args.steps / t_obs_u
     layer = filter_layer(obs)
     print(f"grid={layer.grid.shape} map={layer.obs_config.map_size} sensors={raw.unwrapped.suite.n}")
     print(f"raw_steps_per_s={raw_sps:.0f}")
@@ -102,6 +114,10 @@ def main() -> None:
     print(f"wrapper_other_ms_per_step_q1={1e3 * (t_obs1 - t_raw - up1.sum()) / args.steps:.3f}")
     print(f"observer_overhead_q1={raw_sps / obs1_sps:.3f}")
     print(f"observed_q1_over_q0={obs1_sps / obs_sps:.3f}")
+    print(f"raw_steps_per_s_unicycle={raw_sps_u:.0f}")
+    print(f"observed_steps_per_s_unicycle={obs_sps_u:.0f}")
+    print(f"observer_update_median_ms_unicycle={1e3 * np.median(up_u):.3f}")
+    print(f"observer_overhead_unicycle={raw_sps_u / obs_sps_u:.3f}")
     print(f"observed_steps_per_s={obs_sps:.0f}")
     print(f"observer_update_median_ms={1e3 * np.median(up):.3f}")
     print(f"observer_update_p99_ms={1e3 * np.percentile(up, 99):.3f}")

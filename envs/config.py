@@ -1,80 +1,41 @@
 """Frozen, validated configuration of the exploration environment.
 
-Every config is a frozen dataclass. :meth:`_Config.from_dict` builds one from a mapping and rejects unknown
+Every config is a frozen dataclass on the project's config base (:mod:`digslam.observer.core.config`).
+:meth:`~digslam.observer.core.config.Config.from_dict` builds one from a mapping and rejects unknown
 keys with a ``ValueError`` naming them; the constructors validate values and name the offending field.
 Noise bounds default to the thesis's orders of magnitude (§6.4.2: 0.001 m/s, 0.001 rad/s, 0.01 m).
 """
 
 from __future__ import annotations
 
-import functools
 import math
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, fields, replace
-from typing import Any, TypeVar
+from collections.abc import Mapping
+from dataclasses import field
+
+from digslam.observer.core.config import (
+    Config,
+    check,
+    check_choice,
+    check_finite_nonneg,
+    check_finite_pos,
+    check_in,
+    config_dataclass,
+    is_int,
+)
 
 NOISE_MODELS = ("uniform", "adversarial", "biased")
 WORLDS = ("room", "rocks", "caves", "rooms", "file")
-
-C = TypeVar("C", bound="_Config")
-
-
-def _reject_unknown(cls: type, keys: object) -> None:
-    known = {f.name for f in fields(cls)}
-    unknown = sorted(set(keys) - known)  # type: ignore[call-overload]
-    if unknown:
-        raise ValueError(f"{cls.__name__}: unknown configuration key(s) {unknown}; known: {sorted(known)}")
-
-
-def config_dataclass(cls: type[C]) -> type[C]:
-    """``@dataclass(frozen=True)`` whose constructor raises ``ValueError`` (not ``TypeError``) on bad keys."""
-    cls = dataclass(frozen=True)(cls)
-    init: Callable[..., None] = cls.__init__  # type: ignore[misc]
-
-    @functools.wraps(init)
-    def __init__(self: Any, *args: Any, **kwargs: Any) -> None:
-        _reject_unknown(type(self), kwargs)
-        init(self, *args, **kwargs)
-
-    cls.__init__ = __init__  # type: ignore[misc]
-    return cls
-
-
-class _Config:
-    """Mixin: construction from a mapping that rejects unknown keys."""
-
-    @classmethod
-    def from_dict(cls: type[C], data: Mapping[str, Any] | None = None, **kwargs: Any) -> C:
-        """Build from ``data`` and keyword overrides; an unknown key raises ``ValueError`` naming it."""
-        merged = {**(data or {}), **kwargs}
-        _reject_unknown(cls, merged)
-        return cls(**merged)
-
-    def replace(self: C, **kwargs: Any) -> C:
-        """Copy with some fields changed (unknown keys rejected)."""
-        _reject_unknown(type(self), kwargs)
-        return replace(self, **kwargs)  # type: ignore[type-var]
-
-
-def _check(cond: bool, name: str, msg: str) -> None:
-    if not cond:
-        raise ValueError(f"{name}: {msg}")
-
-
-def _finite_nonneg(name: str, v: float) -> None:
-    _check(
-        isinstance(v, (int, float)) and math.isfinite(v) and v >= 0,
-        name,
-        f"must be finite and >= 0, got {v!r}",
-    )
+#: How the robot moves (:mod:`digslam.envs.sim.robot`): pymunk rigid-body dynamics or exact unicycle arcs.
+DYNAMICS = ("pymunk", "unicycle")
 
 
 @config_dataclass
-class NoiseConfig(_Config):
+class NoiseConfig(Config):
     """Bounded measurement noise.
 
     Attributes:
-        speed: Half-width of the odometry speed error (m/s).
+        speed: Half-width of the odometry velocity error (m/s): the forward speed and, under pymunk dynamics,
+            the leftward velocity (a Doppler velocity log measures both body-frame components).
         yaw_rate: Half-width of the odometry yaw-rate error (rad/s).
         heading: Half-width of the compass error (rad).
         range: Half-width of the range error (m).
@@ -98,26 +59,20 @@ class NoiseConfig(_Config):
 
     def __post_init__(self) -> None:
         for name in ("speed", "yaw_rate", "heading", "range"):
-            _finite_nonneg(f"noise.{name}", getattr(self, name))
-        _check(
-            self.model in NOISE_MODELS, "noise.model", f"must be one of {NOISE_MODELS}, got {self.model!r}"
-        )
-        _check(-1.0 <= self.bias <= 1.0, "noise.bias", f"must be in [-1, 1], got {self.bias!r}")
-        _check(
-            0.0 <= self.outlier_prob <= 1.0,
-            "noise.outlier_prob",
-            f"must be in [0, 1], got {self.outlier_prob!r}",
-        )
+            check_finite_nonneg(f"noise.{name}", getattr(self, name))
+        check_choice("noise.model", self.model, NOISE_MODELS)
+        check_in("noise.bias", self.bias, -1.0, 1.0)
+        check_in("noise.outlier_prob", self.outlier_prob, 0.0, 1.0)
         m = self.max_outliers
-        _check(
-            m is None or (isinstance(m, int) and not isinstance(m, bool) and m >= 0),
+        check(
+            m is None or (is_int(m) and m >= 0),
             "noise.max_outliers",
             f"must be None or an integer >= 0, got {m!r}",
         )
 
 
 @config_dataclass
-class ExploreConfig(_Config):
+class ExploreConfig(Config):
     """Configuration of ``digslam/Explore-v0``.
 
     Attributes:
@@ -126,13 +81,18 @@ class ExploreConfig(_Config):
         n_obstacles: Number of rocks (``world='rocks'``).
         map_path: Polygon (``.json``/``.npz``) or image file for ``world="file"``.
         fixed_world: Keep the world of the first reset (True) or draw a new one at each reset.
-        robot_radius: Robot disc radius (m); the kinematics (:mod:`.robot`) keep this disc off every wall.
-            Start poses keep ``1.5 * robot_radius`` plus a skin of ``1.5 * max_speed * dt / substeps``.
+        robot_radius: Robot disc radius (m); the dynamics (:mod:`digslam.envs.sim.robot`) keep this disc off
+            every wall. Start poses keep ``1.5 * robot_radius`` plus a skin of ``1.5 * max_speed * dt /
+            substeps``, which also pads pymunk's collision disc.
         max_speed: Speed for a normalised action of 1 (m/s).
         max_yaw_rate: Yaw rate for a normalised action of 1 (rad/s).
         dt: Step duration (s).
-        substeps: Physics substeps per step (each one exact arc, possibly slowed or stopped by a wall).
-        max_force: Force limit of the drive joint of the pymunk reference loop (N; benchmarks only).
+        substeps: Physics substeps per step (pymunk steps of exact durations summing to ``dt``; unicycle:
+            exact arcs, possibly slowed or stopped by a wall).
+        dynamics: ``pymunk`` (rigid-body dynamics with inertia, wall contacts and sliding; the default) or
+            ``unicycle`` (exact arcs, blocked by walls; the thesis's missions).
+        max_force: Force limit of the drive joint (N; pymunk dynamics; for the unicycle, the benchmarks'
+            reference loop only).
         max_torque: Torque limit of its steering joint (N m).
         n_sonars: Number of sonar cones, evenly spread around the heading.
         sonar_gamma: Half-aperture of each cone (rad), in (0, pi].
@@ -154,6 +114,7 @@ class ExploreConfig(_Config):
     max_yaw_rate: float = 1.0
     dt: float = 0.1
     substeps: int = 4
+    dynamics: str = "pymunk"
     max_force: float = 50.0
     max_torque: float = 50.0
     n_sonars: int = 8
@@ -168,9 +129,10 @@ class ExploreConfig(_Config):
     def __post_init__(self) -> None:
         if isinstance(self.noise, Mapping):
             object.__setattr__(self, "noise", NoiseConfig.from_dict(self.noise))
-        _check(isinstance(self.noise, NoiseConfig), "noise", "must be a NoiseConfig or a mapping")
-        _check(self.world in WORLDS, "world", f"must be one of {WORLDS}, got {self.world!r}")
-        _check(self.world != "file" or bool(self.map_path), "map_path", "is required when world='file'")
+        check(isinstance(self.noise, NoiseConfig), "noise", "must be a NoiseConfig or a mapping")
+        check_choice("world", self.world, WORLDS)
+        check_choice("dynamics", self.dynamics, DYNAMICS)
+        check(self.world != "file" or bool(self.map_path), "map_path", "is required when world='file'")
         for name in (
             "world_size",
             "robot_radius",
@@ -183,25 +145,18 @@ class ExploreConfig(_Config):
             "omni_range",
             "coverage_resolution",
         ):
-            v = getattr(self, name)
-            _check(
-                isinstance(v, (int, float)) and math.isfinite(v) and v > 0,
-                name,
-                f"must be finite and > 0, got {v!r}",
-            )
+            check_finite_pos(name, getattr(self, name))
         for name in ("substeps", "n_sonars", "n_obstacles"):
             v = getattr(self, name)
-            _check(isinstance(v, int) and v >= (1 if name == "substeps" else 0), name, f"invalid count {v!r}")
-        _check(
-            self.n_sonars + int(self.omni) > 0, "n_sonars", "need at least one range sensor (or omni=True)"
-        )
-        _check(
+            check(isinstance(v, int) and v >= (1 if name == "substeps" else 0), name, f"invalid count {v!r}")
+        check(self.n_sonars + int(self.omni) > 0, "n_sonars", "need at least one range sensor (or omni=True)")
+        check(
             0.0 < self.sonar_gamma <= math.pi,
             "sonar_gamma",
             f"aperture must be in (0, pi], got {self.sonar_gamma!r}",
         )
         if self.start is not None:
-            _check(
+            check(
                 len(self.start) == 3 and all(math.isfinite(float(s)) for s in self.start),
                 "start",
                 f"must be a finite (x, y, theta), got {self.start!r}",
@@ -209,9 +164,9 @@ class ExploreConfig(_Config):
 
 
 __all__ = [
+    "DYNAMICS",
     "ExploreConfig",
     "NOISE_MODELS",
     "NoiseConfig",
     "WORLDS",
-    "config_dataclass",
 ]

@@ -48,11 +48,11 @@ Usage: ``python examples/a5_test_case1_translation.py [--out DIR] [--eps EPS] [-
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, report, save_figure
 
 from digslam.observer.thick.function import ThickFunction
 from digslam.observer.thick.paver import ThickPaving, thick_pave
@@ -207,19 +207,17 @@ def run(eps: float = 0.1, out: str | Path | None = None, classical_min_eps: floa
            "dark_area": p.dark_area, "boundary_area": p.boundary_area, "bisections": p.bisections,
            "classical_bisections": pc.bisections, "classical_boundary_area": pc.boundary_area}  # fmt: skip
     if out is not None:
-        from digslam.observer.paving.draw import new_figure, save_figure
+        from digslam.observer.paving.draw import new_figure
 
         fig, axes = new_figure(2, 1, size=4.5)
         pc.draw(axes[0], FRAME, f"classical intervals (ε = {eps})")
         p.draw(axes[1], FRAME, f"thick intervals, ThickSivia (ε = {eps})")
-        res["figure"] = str(save_figure(fig, Path(out) / "a5_test_case1_translation.png"))
+        res["figure"] = str(save_figure(fig, out, "a5_test_case1_translation.png"))
     return res
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--out", default="out")
-    ap.add_argument("--eps", type=float, default=0.1)
+def main(argv: list[str] | None = None) -> dict:
+    ap = parser(__doc__, eps=0.1)
     ap.add_argument(
         "--classical-min-eps",
         type=float,
@@ -233,7 +231,7 @@ def main() -> None:
         metavar="R",
         help="also test against a paving of ⟦Y⟧ at ε_Y = R·ε (the thesis' Remark A.2)",
     )
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     r = run(a.eps, a.out, a.classical_min_eps, y_paving=a.y_paving)
     print(f"{'eps':>6} | {'classical':>10} {'thesis':>10} | {'ours':>8} {'thesis':>8} | "
           f"{'ours s':>7} {'class. s':>8}")  # fmt: skip
@@ -243,7 +241,8 @@ def main() -> None:
         print(f"{row['eps']:6g} | {cl:>10} {row['thesis_classical']:>10} | {row['ours']:>8} "
               f"{row['thesis_ours']:>8} | {row['ours_s']:7.4f} {cs:>8}"
               + (f" | paved Y: {row['paved']}" if "paved" in row else ""))  # fmt: skip
-    print({k: v for k, v in r.items() if k != "table"})
+    report(r, skip=("table",))
+    return r
 
 
 if __name__ == "__main__":

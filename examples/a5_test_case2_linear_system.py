@@ -12,11 +12,11 @@ Usage: ``python examples/a5_test_case2_linear_system.py [--out DIR] [--eps EPS]`
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, report, save_figure
 
 from digslam.observer.thick.function import ThickFunction
 from digslam.observer.thick.sivia import thick_sivia
@@ -91,7 +91,7 @@ def run(eps: float = 0.01, out: str | Path | None = None) -> dict:
            "tolerable_area": ex["tolerable"], "united_area": ex["united"],
            "united_bbox": ex["united_bbox"]}  # fmt: skip
     if out is not None:
-        from digslam.observer.paving.draw import draw_polygon, new_figure, save_figure
+        from digslam.observer.paving.draw import draw_polygon, new_figure
 
         fig, ax = new_figure(1, 1, size=5.0)
         p.draw(ax, FRAME, f"Eq. A.40: tolerable ⊂ united solution set, ε = {eps}")
@@ -99,13 +99,16 @@ def run(eps: float = 0.01, out: str | Path | None = None) -> dict:
             if len(poly) >= 3:
                 draw_polygon(poly, ax, edgecolor="w", linewidth=0.6)
         ax.axhline(0, color="w", lw=0.5), ax.axvline(0, color="w", lw=0.5)
-        res["figure"] = str(save_figure(fig, Path(out) / "a5_test_case2_linear_system.png"))
+        res["figure"] = str(save_figure(fig, out, "a5_test_case2_linear_system.png"))
     return res
 
 
+def main(argv: list[str] | None = None) -> dict:
+    a = parser(__doc__, eps=0.01).parse_args(argv)
+    r = run(a.eps, a.out)
+    report(r)
+    return r
+
+
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--out", default="out")
-    ap.add_argument("--eps", type=float, default=0.01)
-    a = ap.parse_args()
-    print(run(a.eps, a.out))
+    main()

@@ -13,11 +13,11 @@ Usage: ``python examples/a5_test_case3_parameter_estimation.py [--out DIR] [--ep
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, report, save_figure
 
 from digslam.observer import Function, exp
 from digslam.observer.core import arith
@@ -57,20 +57,23 @@ def run(eps: float = 0.1, out: str | Path | None = None) -> dict:
            "penumbra_area": p.penumbra_area, "dark_area": p.dark_area, "boundary_area": p.boundary_area,
            "classical_boundary_area": pc.boundary_area, "thesis": THESIS}  # fmt: skip
     if out is not None:
-        from digslam.observer.paving.draw import new_figure, save_figure
+        from digslam.observer.paving.draw import new_figure
 
         fig, axes = new_figure(2, 1, size=4.5)
         pc.draw(axes[0], FRAME, f"classical: {pc.n_boxes} boxes")
         p.draw(axes[1], FRAME, f"ThickSivia: {p.n_boxes} boxes")
         for ax in axes:
             ax.set_xlabel("x₁"), ax.set_ylabel("x₂")
-        res["figure"] = str(save_figure(fig, Path(out) / "a5_test_case3_parameter_estimation.png"))
+        res["figure"] = str(save_figure(fig, out, "a5_test_case3_parameter_estimation.png"))
     return res
 
 
+def main(argv: list[str] | None = None) -> dict:
+    a = parser(__doc__, eps=0.1).parse_args(argv)
+    r = run(a.eps, a.out)
+    report(r)
+    return r
+
+
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--out", default="out")
-    ap.add_argument("--eps", type=float, default=0.1)
-    a = ap.parse_args()
-    print(run(a.eps, a.out))
+    main()

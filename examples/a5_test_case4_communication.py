@@ -13,11 +13,11 @@ Usage: ``python examples/a5_test_case4_communication.py [--out DIR] [--eps EPS]`
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, report, save_figure
 
 from digslam.observer.thick.function import ThickFunction
 from digslam.observer.thick.sivia import thick_sivia
@@ -61,18 +61,21 @@ def run(eps: float = 0.1, out: str | Path | None = None, grid: int = 1200) -> di
            "boundary_area": p.boundary_area, "classical_bisections": pc.bisections,
            "grid_lower_area": ga["lower"], "grid_upper_area": ga["upper"]}  # fmt: skip
     if out is not None:
-        from digslam.observer.paving.draw import draw_boxes, new_figure, save_figure
+        from digslam.observer.paving.draw import draw_boxes, new_figure
 
         fig, ax = new_figure(1, 1, size=5.0)
         p.draw(ax, FRAME, f"communication area, ε = {eps}")
         draw_boxes(M_LO, M_HI, ax=ax, color="k", autoscale=False, zorder=3)
-        res["figure"] = str(save_figure(fig, Path(out) / "a5_test_case4_communication.png"))
+        res["figure"] = str(save_figure(fig, out, "a5_test_case4_communication.png"))
     return res
 
 
+def main(argv: list[str] | None = None) -> dict:
+    a = parser(__doc__, eps=0.1).parse_args(argv)
+    r = run(a.eps, a.out)
+    report(r)
+    return r
+
+
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--out", default="out")
-    ap.add_argument("--eps", type=float, default=0.1)
-    a = ap.parse_args()
-    print(run(a.eps, a.out))
+    main()

@@ -24,11 +24,11 @@ Usage: ``python examples/a8_thick_representations.py [--out DIR] [--eps EPS] [--
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer.thick.function import ThickFunction
 from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
@@ -71,12 +71,12 @@ def run(eps: float = 0.1, out: str | Path | None = None) -> dict:
                      "penumbra_area": p.penumbra_area, "dark_area": p.dark_area,
                      "boundary_area": p.boundary_area, "thesis_seconds": THESIS_SECONDS[kind]}  # fmt: skip
     if out is not None:
-        res["png"] = draw(res, Path(out) / "a8_thick_representations.png")
+        res["png"] = draw(res, out)
     return res
 
 
-def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.paving.draw import new_figure, save_figure
+def draw(res: dict, out: str | Path) -> Path:
+    from digslam.observer.paving.draw import new_figure
 
     fig, axes = new_figure(ncols=3, size=4.5)
     for ax, kind in zip(axes, ("classical", "subset_supset", "lower_upper"), strict=True):
@@ -85,7 +85,7 @@ def draw(res: dict, path: Path) -> Path:
                  f"undet. {r['boundary_area']:.2f}")  # fmt: skip
         res["pavings"][kind].draw(ax, FRAME, title)
     fig.suptitle(f"Fig. A.8: test-case 1 (thick translation), ε = {res['eps']:g}")
-    return save_figure(fig, path)
+    return save_figure(fig, out, "a8_thick_representations.png")
 
 
 def _split(box: np.ndarray, n: int, ratio: float) -> np.ndarray:
@@ -137,9 +137,7 @@ def rule_variants(eps_list: tuple[float, ...] = (0.5, 0.1, 0.05, 0.01, 0.005)) -
 
 
 def main(argv: list[str] | None = None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default="out", help="output folder (default: out/)")
-    ap.add_argument("--eps", type=float, default=0.1, help="paver precision ε (default 0.1, as Fig. A.8)")
+    ap = parser(__doc__, eps=0.1, eps_help="paver precision ε (default 0.1, as Fig. A.8)")
     ap.add_argument("--rules", action="store_true", help="also run the bisection-rule study (item 4b)")
     args = ap.parse_args(argv)
     r = run(args.eps, args.out)

@@ -22,12 +22,12 @@ Usage: ``python examples/alg6_1_explicit_slam.py [--out DIR] [--duration S] [--s
 
 from __future__ import annotations
 
-import argparse
 import math
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.envs.config import NoiseConfig
 from digslam.envs.sim.generators import RockField
@@ -135,11 +135,11 @@ def run(duration: float = 240.0, seed: int = 3, period: float = 2.0, scope: floa
         "shapes": len(shapes), "result": res,
     }  # fmt: skip
     if out is not None:
-        stats["figure"] = str(draw(res, world, truth, grid, Path(out)))
+        stats["figure"] = str(draw(res, world, truth, grid, out))
     return stats
 
 
-def draw(res: ExplicitSlamResult, world: World, truth: np.ndarray, grid: Grid, out: Path) -> Path:
+def draw(res: ExplicitSlamResult, world: World, truth: np.ndarray, grid: Grid, out: str | Path) -> Path:
     """Tube vs dead reckoning; thick map (clear red, penumbra orange, dark blue) over the rocks; widths."""
     import matplotlib
 
@@ -149,7 +149,6 @@ def draw(res: ExplicitSlamResult, world: World, truth: np.ndarray, grid: Grid, o
 
     from digslam.observer.paving.draw import draw_grid
 
-    out.mkdir(parents=True, exist_ok=True)
     fig, (a, b, c) = plt.subplots(1, 3, figsize=(19, 6.2))
     rings = [np.vstack([r, r[:1]]) for r in world.rings]
     k = np.arange(0, res.tube.T + 1, 20)
@@ -175,18 +174,11 @@ def draw(res: ExplicitSlamResult, world: World, truth: np.ndarray, grid: Grid, o
     c.set_ylabel("max gate width (m)")
     c.legend()
     fig.tight_layout()
-    path = out / "alg6_1_explicit_slam.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, out, "alg6_1_explicit_slam.png", dpi=110)
 
 
 def main(argv: list[str] | None = None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="out")
-    ap.add_argument("--duration", type=float, default=240.0)
-    ap.add_argument("--seed", type=int, default=3)
-    args = ap.parse_args(argv)
+    args = parser(__doc__.splitlines()[0], duration=240.0, seed=3).parse_args(argv)
     st = run(args.duration, args.seed, out=args.out)
     print(f"Algorithm 6.1: {st['iterations']} passes in {st['seconds']:.1f} s, "
           f"consistent={st['consistent']}, truth in tube: {st['truth_in_tube']}")  # fmt: skip

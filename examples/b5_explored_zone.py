@@ -18,11 +18,11 @@ Usage: ``python examples/b5_explored_zone.py [--out DIR] [--m M]``.
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, report, save_figure
 
 from digslam.observer.slam.explored import explored_disks_grid, explored_hypotheses
 from digslam.observer.slam.explored_sweep import explored_sectors_grid, explored_sweep_grid, sweep_gates
@@ -111,7 +111,7 @@ def run(m: int = 12000, out: str | Path | None = None, sweep_m: int = 1500, cell
            "b2_cross_clear_cells": b2["cross_clear_cells"], "b2_hull_clear_cells": b2["hull_clear_cells"],
            "final_tube_halfwidth": float(sv["e"][-1])}  # fmt: skip
     if out is not None:
-        from digslam.observer.paving.draw import draw_grid, new_figure, save_figure
+        from digslam.observer.paving.draw import draw_grid, new_figure
 
         fig, axes = new_figure(2, 1, size=6.0)
         panels = ((axes[0], disks, g, sv, "patch (disks), cf. Fig. B.8"),
@@ -122,21 +122,25 @@ def run(m: int = 12000, out: str | Path | None = None, sweep_m: int = 1500, cell
             ax.plot(*data["nominal"].T, "k-", lw=0.5)
             ax.plot(*data["true"].T, "w:", lw=0.8)
             ax.set_title(title)
-        res["figure"] = str(save_figure(fig, Path(out) / "b5_explored_zone.png"))
+        res["figure"] = str(save_figure(fig, out, "b5_explored_zone.png"))
         fig, axes = new_figure(4, 1, size=3.5)
         titles = ("trajectory a", "trajectory b", "a or b (Eq. B.7)", "hull tube")
         for ax, key, title in zip(axes, ("a", "b", "joined", "hull"), titles):
             draw_grid(b2[key], b2["grid"].extent, ax=ax, thick=True, penumbra=int(PENUMBRA),
                       colors={1: "#e41a1c", 2: "#ff8c00", -1: "#08306b", 0: "#ffffff"})  # fmt: skip
             ax.set_title(title)
-        res["figure_b2"] = str(save_figure(fig, Path(out) / "b5_fig_b2.png"))
+        res["figure_b2"] = str(save_figure(fig, out, "b5_fig_b2.png"))
     return res
 
 
+def main(argv: list[str] | None = None) -> dict:
+    ap = parser(__doc__)
+    ap.add_argument("--m", type=int, default=12000, help="sensing times of the patch survey (default 12000)")
+    a = ap.parse_args(argv)
+    r = run(a.m, a.out)
+    report(r)
+    return r
+
+
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--out", default="out")
-    ap.add_argument("--m", type=int, default=12000)
-    a = ap.parse_args()
-    for k, v in run(a.m, a.out).items():
-        print(f"{k}: {v}")
+    main()

@@ -26,11 +26,11 @@ Usage: ``python examples/ex2_5_goniometric.py [--out DIR] [--eps EPS]``; writes 
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer import Box, CtcFwdBwd, Function, Interval, Sep, SepInter, cos, pave, sin
 from digslam.observer.polar.sep import SepLandmark
@@ -158,12 +158,12 @@ def run(eps: float = 0.05, out: str | Path | None = None) -> dict:
     res["pavings"] = {"contractor": pc, "separator": ps}
     res["fixpoint"] = res["propagation"][-1]["after_c2"]
     if out is not None:
-        res["png"] = draw(res, Path(out) / "ex2_5_goniometric.png")
+        res["png"] = draw(res, out)
     return res
 
 
-def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.paving.draw import draw_paving, new_figure, save_figure
+def draw(res: dict, out: str | Path) -> Path:
+    from digslam.observer.paving.draw import draw_paving, new_figure
 
     fig, axes = new_figure(ncols=3, size=4.5)
     ax = axes[0]
@@ -198,13 +198,11 @@ def draw(res: dict, path: Path) -> Path:
         ax.plot(*TRUE_POSITION, "k+")
     fig.suptitle(f"Ex. 2.5: bearings 45° and 120° ± 3°, [x0] = [-4, 6]², ε = {res['eps']:g}; "
                  f"exact area {res['exact_area']:.4f}")  # fmt: skip
-    return save_figure(fig, path)
+    return save_figure(fig, out, "ex2_5_goniometric.png")
 
 
 def main(argv: list[str] | None = None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default="out", help="output folder (default: out/)")
-    ap.add_argument("--eps", type=float, default=0.05, help="paver precision ε (default 0.05)")
+    ap = parser(__doc__, eps=0.05)
     args = ap.parse_args(argv)
     r = run(args.eps, args.out)
     print(f"Example 2.5 at eps={r['eps']:g}: X is a quadrilateral of area {r['exact_area']:.4f}, hull "

@@ -10,11 +10,11 @@ and prints the areas, checked against the exact area of X (midpoint-rule quadrat
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer import Box, Function, Interval, SepInverse, pave
 
@@ -80,14 +80,14 @@ def run(eps: float = 0.05, out: str | Path | None = None, exact_n: int = 2000) -
         "paving": p,
     }
     if out is not None:
-        res["png"] = draw(p, Path(out) / "ex2_6_three_rings.png")
+        res["png"] = draw(p, out)
     return res
 
 
-def draw(p, path: Path) -> Path:
+def draw(p, out: str | Path) -> Path:
     from matplotlib.patches import Circle
 
-    from digslam.observer.paving.draw import draw_paving, new_figure, save_figure
+    from digslam.observer.paving.draw import draw_paving, new_figure
 
     fig, ax = new_figure(size=7)
     draw_paving(p, ax, frame=FRAME, linewidth=0.1)
@@ -95,16 +95,12 @@ def draw(p, path: Path) -> Path:
         for r in radii:
             ax.add_patch(Circle((cx, cy), r, fill=False, edgecolor=color, linewidth=1.2, zorder=4))
     ax.set_title(f"Ex. 2.6: X = (X1 ∩ X2) ∪ (X3 \\ X1), ε = {p.eps:g}")
-    return save_figure(fig, path)
+    return save_figure(fig, out, "ex2_6_three_rings.png")
 
 
 def main(argv: list[str] | None = None) -> dict:
-    parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
-    parser.add_argument("--out", default="out", help="output folder (default: out/)")
-    parser.add_argument("--eps", type=float, default=0.05, help="paver precision ε (default 0.05)")
-    args = parser.parse_args(argv)
+    ap = parser(__doc__, eps=0.05)
+    args = ap.parse_args(argv)
     r = run(args.eps, args.out, exact_n=4000)
     print(
         f"Example 2.6 at eps={r['eps']:g}: {r['n_inner']} inner, {r['n_outer']} outer, "

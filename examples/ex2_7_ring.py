@@ -11,11 +11,11 @@ Usage: ``python examples/ex2_7_ring.py [--out DIR] [--eps EPS]``; writes ``DIR/e
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer import Box, CtcFwdBwd, Function, Interval, Sep, SepInverse, pave
 
@@ -64,12 +64,12 @@ def run(eps: float = 0.05, out: str | Path | None = None) -> dict:
         "pavings": (pc, ps),
     }  # fmt: skip
     if out is not None:
-        res["png"] = draw(pc, ps, Path(out) / "ex2_7_ring.png")
+        res["png"] = draw(pc, ps, out)
     return res
 
 
-def draw(pc, ps, path: Path) -> Path:
-    from digslam.observer.paving.draw import draw_paving, new_figure, save_figure
+def draw(pc, ps, out: str | Path) -> Path:
+    from digslam.observer.paving.draw import draw_paving, new_figure
 
     fig, (a, b) = new_figure(ncols=2, size=5)
     draw_paving(
@@ -87,16 +87,12 @@ def draw(pc, ps, path: Path) -> Path:
         title=f"separator: undetermined {ps.boundary_area:.3f}, {ps.bisections} bisections",
     )
     fig.suptitle(f"Ex. 2.7: ring (x1-2)² + (x2-2.5)² ∈ [1, 1.5²], ε = {ps.eps:g}")
-    return save_figure(fig, path)
+    return save_figure(fig, out, "ex2_7_ring.png")
 
 
 def main(argv: list[str] | None = None) -> dict:
-    parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
-    parser.add_argument("--out", default="out", help="output folder (default: out/)")
-    parser.add_argument("--eps", type=float, default=0.05, help="paver precision ε (default 0.05)")
-    args = parser.parse_args(argv)
+    ap = parser(__doc__, eps=0.05)
+    args = ap.parse_args(argv)
     r = run(args.eps, args.out)
     print(f"Example 2.7 at eps={r['eps']:g}: exact ring area 5π/4 = {r['exact_area']:.4f}")
     for k in ("contractor", "separator"):

@@ -12,11 +12,11 @@ Usage: ``python examples/ex2_8_rotated_polygon.py [--out DIR] [--eps EPS]``; wri
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer import Box, Function, Interval, SepInverse, SepPolygon, pave
 
@@ -113,12 +113,12 @@ def run(eps: float = 0.02, out: str | Path | None = None) -> dict:
             "bisections": p.bisections,
         }
     if out is not None:
-        res["png"] = draw(pavings, Path(out) / "ex2_8_rotated_polygon.png")
+        res["png"] = draw(pavings, out)
     return res
 
 
-def draw(pavings, path: Path) -> Path:
-    from digslam.observer.paving.draw import draw_paving, draw_polygon, new_figure, save_figure
+def draw(pavings, out: str | Path) -> Path:
+    from digslam.observer.paving.draw import draw_paving, draw_polygon, new_figure
 
     fig, axes = new_figure(ncols=3, size=4.5)
     titles = ("(a) M", "(b) R_π/4(M)", "(c) R_π/4(M) ∩ ~M")
@@ -127,16 +127,12 @@ def draw(pavings, path: Path) -> Path:
         draw_polygon(M, ax, edgecolor="k", linewidth=0.8)
         draw_polygon(rotate(M, ANGLE), ax, edgecolor="w", linewidth=0.8, linestyle="--")
     fig.suptitle(f"Ex. 2.8: inversion of a polygon separator by a rotation, ε = {pavings[0].eps:g}")
-    return save_figure(fig, path)
+    return save_figure(fig, out, "ex2_8_rotated_polygon.png")
 
 
 def main(argv: list[str] | None = None) -> dict:
-    parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
-    parser.add_argument("--out", default="out", help="output folder (default: out/)")
-    parser.add_argument("--eps", type=float, default=0.02, help="paver precision ε (default 0.02)")
-    args = parser.parse_args(argv)
+    ap = parser(__doc__, eps=0.02)
+    args = ap.parse_args(argv)
     r = run(args.eps, args.out)
     print(
         f"Example 2.8 at eps={r['eps']:g} ({r['seconds']:.2f} s): "

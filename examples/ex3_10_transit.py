@@ -18,11 +18,11 @@ writes ``DIR/ex3_10_transit.png``.
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer.core import arith as A
 from digslam.observer.core import trig as T
@@ -119,12 +119,12 @@ def run(
     res["ratio_i0"] = res["fwdbwd"]["diameter_i0"] / res["polar"]["diameter_i0"]
     res["ratio_dr"] = res["fwdbwd"]["diameter_dr"] / res["polar"]["diameter_dr"]
     if out is not None:
-        res["png"] = draw(res, Path(out) / "ex3_10_transit.png")
+        res["png"] = draw(res, out)
     return res
 
 
-def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.paving.draw import new_figure, save_figure
+def draw(res: dict, out: str | Path) -> Path:
+    from digslam.observer.paving.draw import new_figure
 
     fig, (a, b) = new_figure(ncols=2, size=5)
     x = res["data"]["x"]
@@ -143,13 +143,11 @@ def draw(res: dict, path: Path) -> Path:
     b.set_ylabel("diameter of [x_k] (m)")
     b.legend(fontsize=7)
     b.set_title("Figure 3.10: box diameters")
-    return save_figure(fig, path)
+    return save_figure(fig, out, "ex3_10_transit.png")
 
 
 def main(argv: list[str] | None = None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default="out", help="output folder (default: out/)")
-    ap.add_argument("--eps", type=float, default=0.0, help="unused (no paving); kept for a uniform interface")
+    ap = parser(__doc__, eps=0.0, eps_help="unused (no paving); kept for a uniform interface")
     args = ap.parse_args(argv)
     r = run(args.eps, args.out)
     for key, label in (("i0", "ī = 0"), ("dr", "dead reckoning")):

@@ -19,11 +19,11 @@ Usage: ``python examples/ex3_12_initial_localization.py [--out DIR] [--seed S] [
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer.slam.landmarks import Localization, localize
 
@@ -129,14 +129,14 @@ def run(
         "full_association_at": res.full_association_at, "iterations": len(res.history),
     }  # fmt: skip
     if out is not None:
-        out_d["png"] = draw(out_d, Path(out) / "ex3_12_initial_localization.png")
+        out_d["png"] = draw(out_d, out)
     return out_d
 
 
-def draw(r: dict, path: Path) -> Path:
+def draw(r: dict, out: str | Path) -> Path:
     from matplotlib.patches import Rectangle, Wedge
 
-    from digslam.observer.paving.draw import new_figure, save_figure
+    from digslam.observer.paving.draw import new_figure
 
     d, res = r["data"], r["result"]
     fig, (a, b) = new_figure(ncols=2, size=6)
@@ -165,13 +165,11 @@ def draw(r: dict, path: Path) -> Path:
     b.set_ylabel("w([p](t)) (m)")
     b.set_title("Fig. 3.13: width of the position tube")
     b.legend(fontsize=7)
-    return save_figure(fig, path)
+    return save_figure(fig, out, "ex3_12_initial_localization.png")
 
 
 def main(argv: list[str] | None = None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default="out", help="output folder (default: out/)")
-    ap.add_argument("--seed", type=int, default=SEED)
+    ap = parser(__doc__, seed=SEED)
     ap.add_argument("--noise", default="uniform", choices=["uniform", "bounds"])
     args = ap.parse_args(argv)
     r = run(out=args.out, seed=args.seed, noise=args.noise)

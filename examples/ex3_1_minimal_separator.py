@@ -21,11 +21,11 @@ Usage: ``python examples/ex3_1_minimal_separator.py [--out DIR] [--eps EPS]``; w
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer import Box, Function, Interval, SepInverse, pave
 
@@ -64,12 +64,12 @@ def run(eps: float = EPS, out: str | Path | None = None, frame: Box = FRAME) -> 
     res["ratio"] = res["minimal"]["bisections"] / res["fwdbwd"]["bisections"]
     res["thesis_ratio"] = THESIS["minimal"] / THESIS["fwdbwd"]
     if out is not None:
-        res["png"] = draw(res, Path(out) / "ex3_1_minimal_separator.png")
+        res["png"] = draw(res, out)
     return res
 
 
-def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.paving.draw import draw_paving, new_figure, save_figure
+def draw(res: dict, out: str | Path) -> Path:
+    from digslam.observer.paving.draw import draw_paving, new_figure
 
     fig, axes = new_figure(ncols=2, size=5)
     view = Box([(-4.5, 5), (-8, 8)])  # both first outer boxes
@@ -81,13 +81,11 @@ def draw(res: dict, path: Path) -> Path:
         (a, b), (c, d) = r["first_outer_box"]
         ax.plot([a, c, c, a, a], [b, b, d, d, b], color="w", ls="--", lw=1.5)  # first outer box
     fig.suptitle(f"Ex. 3.1: x1² + |2x2| − x1 ∈ [3, 5], X0 = [-10, 10]², ε = {res['eps']:g}")
-    return save_figure(fig, path)
+    return save_figure(fig, out, "ex3_1_minimal_separator.png")
 
 
 def main(argv: list[str] | None = None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default="out", help="output folder (default: out/)")
-    ap.add_argument("--eps", type=float, default=EPS, help=f"paver precision ε (default {EPS})")
+    ap = parser(__doc__, eps=EPS)
     args = ap.parse_args(argv)
     r = run(args.eps, args.out)
     hull = np.round(EXACT_HULL, 4).tolist()

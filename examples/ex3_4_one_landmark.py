@@ -21,11 +21,11 @@ Usage: ``python examples/ex3_4_one_landmark.py [--out DIR] [--eps EPS]``; writes
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer import Box, pave
 from digslam.observer.polar.sep import SepLandmark, sep_landmark_fwdbwd
@@ -62,12 +62,12 @@ def run(eps: float = 0.01, out: str | Path | None = None, default_cut: bool = Tr
         if default_cut:
             res.setdefault("default_cut", {})[name] = pave(FRAME, sep, eps).bisections
     if out is not None:
-        res["png"] = draw(res, Path(out) / "ex3_4_one_landmark.png")
+        res["png"] = draw(res, out)
     return res
 
 
-def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.paving.draw import draw_paving, new_figure, save_figure
+def draw(res: dict, out: str | Path) -> Path:
+    from digslam.observer.paving.draw import draw_paving, new_figure
 
     fig, axes = new_figure(ncols=2, size=5)
     for ax, (name, label) in zip(axes, (("polar", "minimal polar separator"), ("fwdbwd", "forward-backward")),
@@ -83,13 +83,11 @@ def draw(res: dict, path: Path) -> Path:
         (a, b), (c, d) = r["first_outer_box"]
         ax.plot([a, c, c, a, a], [b, b, d, d, b], "k--", lw=1.2)  # first outer box
     fig.suptitle(f"Fig. 3.6: one landmark, [y] = [4,6]×[-π/12, π/4], ε = {res['eps']:g}")
-    return save_figure(fig, path)
+    return save_figure(fig, out, "ex3_4_one_landmark.png")
 
 
 def main(argv: list[str] | None = None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default="out", help="output folder (default: out/)")
-    ap.add_argument("--eps", type=float, default=0.01, help="paver precision ε (default 0.01)")
+    ap = parser(__doc__, eps=0.01)
     args = ap.parse_args(argv)
     r = run(args.eps, args.out)
     print(f"§3.4.1.1 at eps={r['eps']:g}: exact area 10π/3 = {r['exact_area']:.4f}")

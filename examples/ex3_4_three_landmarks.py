@@ -11,11 +11,11 @@ Usage: ``python examples/ex3_4_three_landmarks.py [--out DIR] [--eps EPS]``; wri
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer import Box, SepInter, pave
 from digslam.observer.polar.sep import SepLandmark, sep_landmark_fwdbwd
@@ -46,12 +46,12 @@ def run(eps: float = 0.05, out: str | Path | None = None) -> dict:
                      "seconds": time.perf_counter() - t}  # fmt: skip
         res["pavings"][kind] = p
     if out is not None:
-        res["png"] = draw(res, Path(out) / "ex3_4_three_landmarks.png")
+        res["png"] = draw(res, out)
     return res
 
 
-def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.paving.draw import draw_paving, new_figure, save_figure
+def draw(res: dict, out: str | Path) -> Path:
+    from digslam.observer.paving.draw import draw_paving, new_figure
 
     fig, ax = new_figure(size=6)
     p = res["pavings"]["polar"]
@@ -66,13 +66,11 @@ def draw(res: dict, path: Path) -> Path:
         (a, b), (c, d) = res[kind]["first_outer_box"]
         ax.plot([a, c, c, a, a], [b, b, d, d, b], style, lw=1.5, label=f"first outer box, {kind}")
     ax.legend(loc="lower left", fontsize=7)
-    return save_figure(fig, path)
+    return save_figure(fig, out, "ex3_4_three_landmarks.png")
 
 
 def main(argv: list[str] | None = None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default="out", help="output folder (default: out/)")
-    ap.add_argument("--eps", type=float, default=0.01, help="paver precision ε (default 0.01)")
+    ap = parser(__doc__, eps=0.01)
     args = ap.parse_args(argv)
     r = run(args.eps, args.out)
     print(f"§3.4.1.2 (Table 3.1) at eps={r['eps']:g}")

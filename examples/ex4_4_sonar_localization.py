@@ -21,11 +21,11 @@ Usage: ``python examples/ex4_4_sonar_localization.py [--out DIR] [--eps EPS] [--
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer import Box, SepPolygon, pave
 from digslam.observer.core.boxes import empty_rows
@@ -181,12 +181,12 @@ def run(eps: float = 0.1, out: str | Path | None = None, eps_proj: float | None 
         "paving": p,
     }
     if out is not None:
-        res["png"] = draw(res, Path(out) / "ex4_4_sonar_localization.png")
+        res["png"] = draw(res, out)
     return res
 
 
-def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.paving.draw import draw_paving, draw_polygon, new_figure, save_figure
+def draw(res: dict, out: str | Path) -> Path:
+    from digslam.observer.paving.draw import draw_paving, draw_polygon, new_figure
 
     fig, axes = new_figure(ncols=3, size=5.0)
     ax = axes[0]
@@ -211,19 +211,16 @@ def draw(res: dict, path: Path) -> Path:
         draw_paving(res["paving"], axes[2], frame=zoom, linewidth=0.1)
         axes[2].plot(*TRUE_POSE, "g+", markersize=12)
         axes[2].set_title("Fig. 4.9 (right): zoom; true pose +")
-    return save_figure(fig, path)
+    return save_figure(fig, out, "ex4_4_sonar_localization.png")
 
 
 def main(argv: list[str] | None = None) -> dict:
-    parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
-    parser.add_argument("--out", default="out", help="output folder (default: out/)")
-    parser.add_argument(
+    ap = parser(__doc__)
+    ap.add_argument(
         "--eps", type=float, default=None, help="paver precision ε (default 0.1, 0.05 with --full)"
     )
-    parser.add_argument("--full", action="store_true", help="the finer run (ε = 0.05)")
-    args = parser.parse_args(argv)
+    ap.add_argument("--full", action="store_true", help="the finer run (ε = 0.05)")
+    args = ap.parse_args(argv)
     eps = args.eps if args.eps is not None else (0.05 if args.full else 0.1)
     r = run(eps, args.out)
     print(

@@ -16,11 +16,11 @@ Usage: ``python examples/ex4_minkowski.py [--out DIR] [--eps EPS]``; writes ``DI
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer import Box, Function, Interval, SepBox, SepInverse, SepPolygon, pave
 from digslam.observer.sets.minkowski import SepMinkowskiDiff, SepMinkowskiSum
@@ -148,12 +148,12 @@ def run(eps: float = 0.05, out: str | Path | None = None, eps_proj: float | None
             **check(p, member),
         }
     if out is not None:
-        res["png"] = draw(res, Path(out))
+        res["png"] = draw(res, out)
     return res
 
 
-def draw(res: dict, out: Path) -> list[Path]:
-    from digslam.observer.paving.draw import draw_paving, draw_polygon, new_figure, save_figure
+def draw(res: dict, out: str | Path) -> list[Path]:
+    from digslam.observer.paving.draw import draw_paving, draw_polygon, new_figure
 
     paths = []
     fig, ax = new_figure(size=5.5)
@@ -162,24 +162,20 @@ def draw(res: dict, out: Path) -> list[Path]:
     ax.plot(RADIUS * np.cos(th), RADIUS * np.sin(th), "k", linewidth=1.0)
     draw_polygon(RECT, ax, edgecolor="g", linewidth=1.2)
     ax.set_title(f"Fig. 4.4: disk(5) ⊖ rectangle 4×2, ε = {res['eps']:g}")
-    paths.append(save_figure(fig, out / "ex4_minkowski_diff.png"))
+    paths.append(save_figure(fig, out, "ex4_minkowski_diff.png"))
     fig, ax = new_figure(size=5.5)
     draw_paving(res["sum"]["paving"], ax, frame=FRAME_SUM, linewidth=0.05)
     draw_polygon(TRIANGLE, ax, edgecolor="g", linewidth=1.2)
     draw_polygon(SQUARE, ax, edgecolor="m", linewidth=1.2)
     draw_polygon(sum_polygon(), ax, edgecolor="k", linewidth=0.8, linestyle="--")
     ax.set_title(f"Fig. 4.5: triangle ⊕ square, ε = {res['eps']:g}")
-    paths.append(save_figure(fig, out / "ex4_minkowski_sum.png"))
+    paths.append(save_figure(fig, out, "ex4_minkowski_sum.png"))
     return paths
 
 
 def main(argv: list[str] | None = None) -> dict:
-    parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
-    parser.add_argument("--out", default="out", help="output folder (default: out/)")
-    parser.add_argument("--eps", type=float, default=0.05, help="paver precision ε (default 0.05)")
-    args = parser.parse_args(argv)
+    ap = parser(__doc__, eps=0.05)
+    args = ap.parse_args(argv)
     r = run(args.eps, args.out)
     for key, name in (("diff", "Ex. 4.1 disk ⊖ rectangle"), ("sum", "Ex. 4.2 triangle ⊕ square")):
         v = r[key]

@@ -15,11 +15,11 @@ Usage: ``python examples/ex4_sonar_registration.py [--out DIR] [--eps EPS]``; wr
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer import Box, Interval, IntervalArray, SepBox, pave
 from digslam.observer.core import rounding, trig
@@ -86,12 +86,12 @@ def run(eps: float = 1e-5, out: str | Path | None = None) -> dict:
         "paving": p,
     }
     if out is not None:
-        res["png"] = draw(res, Path(out) / "ex4_sonar_registration.png")
+        res["png"] = draw(res, out)
     return res
 
 
-def draw(res: dict, path: Path) -> Path:
-    from digslam.observer.paving.draw import new_figure, save_figure
+def draw(res: dict, out: str | Path) -> Path:
+    from digslam.observer.paving.draw import new_figure
 
     fig, ax = new_figure(size=5.0)
     ax.fill([5, 12, 12, 5], [3, 3, 12, 12], hatch="//", facecolor="none", edgecolor="k", linewidth=0.5)
@@ -103,18 +103,12 @@ def draw(res: dict, path: Path) -> Path:
     ax.set_aspect("equal")
     ax.legend(loc="upper left")
     ax.set_title(f"§4.2.3: d ∈ [{res['d'][0]:.6f}, {res['d'][1]:.6f}] (thesis [6.2988, 6.3085])")
-    return save_figure(fig, path)
+    return save_figure(fig, out, "ex4_sonar_registration.png")
 
 
 def main(argv: list[str] | None = None) -> dict:
-    parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
-    parser.add_argument("--out", default="out", help="output folder (default: out/)")
-    parser.add_argument(
-        "--eps", type=float, default=1e-5, help="paver and projection precision (default 1e-5)"
-    )
-    args = parser.parse_args(argv)
+    ap = parser(__doc__, eps=1e-5, eps_help="paver and projection precision (default 1e-5)")
+    args = ap.parse_args(argv)
     r = run(args.eps, args.out)
     print(
         f"§4.2.3 sonar registration at eps={r['eps']:g} ({r['seconds']:.2f} s, {r['bisections']} bisections, "

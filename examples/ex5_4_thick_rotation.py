@@ -10,11 +10,11 @@ Usage: ``python examples/ex5_4_thick_rotation.py [--out DIR] [--eps EPS]``.
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, report, save_figure
 
 from digslam.observer import Box, cos, sin
 from digslam.observer.thick.inversion import thick_inverse_classical, thick_inverse_proj
@@ -59,7 +59,6 @@ def run(eps: float = 0.05, out: str | Path | None = None) -> dict:
             PENUMBRA_COLOR,
             draw_boxes,
             new_figure,
-            save_figure,
         )
 
         fig, axes = new_figure(3, 1, size=4.0)
@@ -76,13 +75,16 @@ def run(eps: float = 0.05, out: str | Path | None = None) -> dict:
             ax.set_title(title)
         for ax in axes:
             ax.set_xlim(0, 7), ax.set_ylim(-1, 6), ax.set_aspect("equal")
-        res["figure"] = str(save_figure(fig, Path(out) / "ex5_4_thick_rotation.png"))
+        res["figure"] = str(save_figure(fig, out, "ex5_4_thick_rotation.png"))
     return res
 
 
+def main(argv: list[str] | None = None) -> dict:
+    a = parser(__doc__, out=".", eps=0.05).parse_args(argv)
+    r = run(a.eps, a.out)
+    report(r)
+    return r
+
+
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--out", default=".")
-    ap.add_argument("--eps", type=float, default=0.05)
-    a = ap.parse_args()
-    print(run(a.eps, a.out))
+    main()

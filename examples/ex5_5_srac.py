@@ -23,13 +23,13 @@ Usage: ``python examples/ex5_5_srac.py [--out DIR] [--eps EPS] [--draw-eps W]``.
 
 from __future__ import annotations
 
-import argparse
 import functools
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer import Function, Interval, SepImage, cos, sin
 from digslam.observer.core import trig
@@ -148,11 +148,11 @@ def run(eps: float = 0.01, out: str | Path | None = None, draw_eps: float = 0.1,
            "result": r, "views": views}  # fmt: skip
     res["no_wider_than_published"] = all(w <= pw for w, pw in zip(res["width"], res["published_width"]))
     if out is not None:
-        res["figure"] = str(draw(res, Path(out) / "ex5_5_srac.png", draw_eps))
+        res["figure"] = str(draw(res, out, draw_eps))
     return res
 
 
-def draw(res: dict, path: Path, draw_eps: float) -> Path:
+def draw(res: dict, out: str | Path, draw_eps: float) -> Path:
     """Figure 5.10: (a) ``[A]``, (b) ``[B]``, (c) carved ``[A]``, (d) carved ``[B]``; Fig. 5.11 inset box."""
     from digslam.observer.paving.draw import (
         BOUNDARY_COLOR,
@@ -161,7 +161,6 @@ def draw(res: dict, path: Path, draw_eps: float) -> Path:
         PENUMBRA_COLOR,
         draw_boxes,
         new_figure,
-        save_figure,
     )
     from digslam.observer.thick.paver import thick_pave
 
@@ -178,13 +177,11 @@ def draw(res: dict, path: Path, draw_eps: float) -> Path:
         ax.set_title(title)
     (p1, p2) = res["p"]
     fig.suptitle(f"SRAC: [p] = [{p1[0]:.5f}, {p1[1]:.5f}] x [{p2[0]:.5f}, {p2[1]:.5f}]  (p* = {P_STAR})")
-    return save_figure(fig, path)
+    return save_figure(fig, out, "ex5_5_srac.png")
 
 
 def main(argv: list[str] | None = None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default="out", help="output folder (default: out/)")
-    ap.add_argument("--eps", type=float, default=0.01, help="paving width of [p] (default 0.01)")
+    ap = parser(__doc__, eps=0.01, eps_help="paving width of [p] (default 0.01)")
     ap.add_argument("--draw-eps", type=float, default=0.1, help="paving width of the drawn thick sets")
     a = ap.parse_args(argv)
     r = run(a.eps, a.out, a.draw_eps)

@@ -21,12 +21,12 @@ Usage: ``python examples/ex6_3_bathymetric_slam.py [--out DIR] [--duration S] [-
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer.core.boxes import width_euclid
 from digslam.observer.slam.shape_registration import ThickImage, level_thick_image, register_translation
@@ -198,15 +198,15 @@ def run(duration: float | None = None, seed: int = 0, bounds: bool = False, out:
         "result": res, "sim": sim, "dead_reckoning": dr,
     }  # fmt: skip
     if out is not None:
-        stats["figure"] = str(draw(stats, Path(out) / "ex6_3_bathymetric_slam.png"))
+        stats["figure"] = str(draw(stats, out))
     return stats
 
 
-def draw(st: dict, path: Path) -> Path:
+def draw(st: dict, out: str | Path) -> Path:
     """(a) truth, dead-reckoning and SLAM tube boxes every 20 s; (b) tube widths over time (Fig. 6.7–6.8)."""
     from matplotlib.patches import Rectangle
 
-    from digslam.observer.paving.draw import new_figure, save_figure
+    from digslam.observer.paving.draw import new_figure
 
     sim, res, dr = st["sim"], st["result"], st["dead_reckoning"]
     fig, (ax, bx) = new_figure(2, 1, size=6.0)
@@ -223,7 +223,7 @@ def draw(st: dict, path: Path) -> Path:
     bx.plot(dr.t / 60, st["dr_width"], "tab:blue", label="dead reckoning")
     bx.plot(res.tube.t / 60, st["slam_width"], "tab:red", label="Algorithm 6.2")
     bx.set_xlabel("time (min)"), bx.set_ylabel("tube width (m)"), bx.legend()
-    return save_figure(fig, path)
+    return save_figure(fig, out, "ex6_3_bathymetric_slam.png")
 
 
 def _fmt(b: Any) -> str:
@@ -231,10 +231,7 @@ def _fmt(b: Any) -> str:
 
 
 def main(argv: list[str] | None = None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", default="out", help="output folder (default: out/)")
-    ap.add_argument("--duration", type=float, default=2340.0, help="mission length in s (default 2400)")
-    ap.add_argument("--seed", type=int, default=0)
+    ap = parser(__doc__, duration=2340.0, seed=0)
     ap.add_argument("--bounds", action="store_true", help="every noise exactly at its bound")
     a = ap.parse_args(argv)
     t0 = time.perf_counter()

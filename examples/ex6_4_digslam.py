@@ -11,11 +11,11 @@ Usage: ``python examples/ex6_4_digslam.py [--out DIR] [--duration S] [--cell M] 
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, report, save_figure
 
 from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.missions import loop_mission
@@ -44,11 +44,11 @@ def run(duration: float = 1200.0, cell: float = 0.05, seed: int = 0, out: str | 
         "penumbra_area": float((res.explored == 2).sum() * np.prod(grid.cell_size)),
     }
     if out is not None:
-        draw(res, world, truth, grid, Path(out))
+        draw(res, world, truth, grid, out)
     return stats
 
 
-def draw(res: DigSlamResult, world: object, truth: np.ndarray, grid: Grid, out: Path) -> None:
+def draw(res: DigSlamResult, world: object, truth: np.ndarray, grid: Grid, out: str | Path) -> None:
     """Fig. 6.12 (tube and ``M⁻`` over the true map) and Fig. 6.13 (widths over time)."""
     import matplotlib
 
@@ -56,7 +56,6 @@ def draw(res: DigSlamResult, world: object, truth: np.ndarray, grid: Grid, out: 
     import matplotlib.pyplot as plt
     from matplotlib.collections import PolyCollection
 
-    out.mkdir(parents=True, exist_ok=True)
     from digslam.observer.paving.draw import draw_grid
 
     fig, (a, b, c) = plt.subplots(1, 3, figsize=(19, 6.2))
@@ -78,8 +77,7 @@ def draw(res: DigSlamResult, world: object, truth: np.ndarray, grid: Grid, out: 
         ax.set_ylim(-10, 10)
         ax.set_aspect("equal")
     fig.tight_layout()
-    fig.savefig(out / "fig6_12_digslam.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, out, "fig6_12_digslam.png", dpi=110)
     fig, ax = plt.subplots(figsize=(9, 4))
     t = res.tube.t
     ax.plot(t, res.dead_reckoning, "r", lw=1, label="dead reckoning")
@@ -92,19 +90,16 @@ def draw(res: DigSlamResult, world: object, truth: np.ndarray, grid: Grid, out: 
     ax.set_ylabel("tube width (m)")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(out / "fig6_13_widths.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, out, "fig6_13_widths.png", dpi=110)
 
 
-def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--out", default="out")
-    p.add_argument("--duration", type=float, default=1200.0)
-    p.add_argument("--cell", type=float, default=0.05)
-    p.add_argument("--seed", type=int, default=0)
-    a = p.parse_args()
-    for k, v in run(a.duration, a.cell, a.seed, a.out).items():
-        print(f"{k}: {v}")
+def main(argv: list[str] | None = None) -> dict:
+    ap = parser(__doc__.splitlines()[0], duration=1200.0, seed=0)
+    ap.add_argument("--cell", type=float, default=0.05, help="grid cell size in m (default 0.05)")
+    a = ap.parse_args(argv)
+    r = run(a.duration, a.cell, a.seed, a.out)
+    report(r)
+    return r
 
 
 if __name__ == "__main__":

@@ -7,13 +7,12 @@ and ``OUT_DIR/<env-name>.npz`` with the recorded episode.
 
 from __future__ import annotations
 
-import argparse
 import os
-from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
 import pygame
+from _common import out_dir, parser
 
 import digslam.envs  # noqa: F401  (registers the environments)
 from digslam.envs import record_episode
@@ -25,16 +24,13 @@ def wander(n: int, rng: np.random.Generator) -> np.ndarray:
     return np.column_stack([np.full(n, 0.8), turn]).astype(np.float32)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("out", nargs="?", default="out")
-    parser.add_argument("--env", default="digslam/Explore-v0")
-    parser.add_argument("--steps", type=int, default=300)
-    parser.add_argument("--seed", type=int, default=0)
-    args = parser.parse_args()
+def main(argv: list[str] | None = None) -> None:
+    ap = parser(__doc__, out=None, steps=300, seed=0)
+    ap.add_argument("out", nargs="?", default="out", help="output folder (default: out/)")
+    ap.add_argument("--env", default="digslam/Explore-v0", help="environment id (default digslam/Explore-v0)")
+    args = ap.parse_args(argv)
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = out_dir(args.out)
     env = gym.make(args.env, render_mode="rgb_array")
     episode = record_episode(env, args.seed, wander(args.steps, np.random.default_rng(args.seed)))
     frame = env.render()

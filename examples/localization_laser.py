@@ -28,11 +28,11 @@ writes ``DIR/localization_laser.png`` (Figures 2.23 and 2.24 side by side).
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer import (
     Box,
@@ -173,12 +173,12 @@ def run(
         "hull_lo": hull[0], "hull_hi": hull[1], "seconds": seconds, "paving": p,
     }  # fmt: skip
     if out is not None:
-        res["png"] = draw(p, meas, Path(out) / "localization_laser.png")
+        res["png"] = draw(p, meas, out)
     return res
 
 
-def draw(p, meas: dict, path: Path) -> Path:
-    from digslam.observer.paving.draw import draw_boxes, draw_polygon, new_figure, save_figure
+def draw(p, meas: dict, out: str | Path) -> Path:
+    from digslam.observer.paving.draw import draw_boxes, draw_polygon, new_figure
 
     fig, (a, b) = new_figure(ncols=2, size=6)
     for ax in (a, b):
@@ -219,24 +219,19 @@ def draw(p, meas: dict, path: Path) -> Path:
         ins.set_aspect("equal")
         ins.tick_params(labelsize=6)
     b.set_title(f"Fig. 2.24: q = {N_OUTLIERS}, ε = {p.eps:g}: X⁻ dark, ΔX light")
-    return save_figure(fig, path)
+    return save_figure(fig, out, "localization_laser.png")
 
 
 def main(argv: list[str] | None = None) -> dict:
-    parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
-    parser.add_argument("--out", default="out", help="output folder (default: out/)")
-    parser.add_argument("--eps", type=float, default=0.01, help="paver precision ε (default 0.01)")
-    parser.add_argument("--seed", type=int, default=1, help="simulation seed (default 1)")
-    parser.add_argument(
+    ap = parser(__doc__, eps=0.01, seed=1)
+    ap.add_argument(
         "--error",
         type=float,
         default=ERROR,
         help=f"amplitude of the simulated range errors, below the bound {NOISE} (default {ERROR})",
     )
-    parser.add_argument("--thesis", action="store_true", help="Eq. 2.85 as written (no outward widening)")
-    args = parser.parse_args(argv)
+    ap.add_argument("--thesis", action="store_true", help="Eq. 2.85 as written (no outward widening)")
+    args = ap.parse_args(argv)
     r = run(args.eps, args.out, args.seed, sound=not args.thesis, error=args.error)
     print(
         f"Laser localization at eps={r['eps']:g} "

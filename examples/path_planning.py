@@ -19,11 +19,11 @@ Usage: ``python examples/path_planning.py [--out DIR] [--eps EPS]``; writes ``DI
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, save_figure
 
 from digslam.observer import Box, Function, SepInverse, SepPolygon, cos, pave, sin
 
@@ -201,12 +201,12 @@ def run(eps: float = 0.02, out: str | Path | None = None) -> dict:
         "pave_seconds": t1 - t0, "graph_seconds": t2 - t1, "paving": p,
     }  # fmt: skip
     if out is not None:
-        res["png"] = draw(p, poly, Path(out) / "path_planning.png")
+        res["png"] = draw(p, poly, out)
     return res
 
 
-def draw(p, poly: np.ndarray, path: Path) -> Path:
-    from digslam.observer.paving.draw import draw_paving, draw_polygon, new_figure, save_figure
+def draw(p, poly: np.ndarray, out: str | Path) -> Path:
+    from digslam.observer.paving.draw import draw_paving, draw_polygon, new_figure
 
     fig, (a, b) = new_figure(ncols=2, size=6)
     draw_paving(p, a, frame=FRAME, linewidth=0.05, title="(a) configuration space M and a feasible path")
@@ -235,16 +235,12 @@ def draw(p, poly: np.ndarray, path: Path) -> Path:
     b.set_ylim(-7.5, 7.5)
     b.set_title("(b) the motion in the world (loop in thick lines)")
     fig.suptitle(f"§2.6.1 wire loop game, ε = {p.eps:g}")
-    return save_figure(fig, path)
+    return save_figure(fig, out, "path_planning.png")
 
 
 def main(argv: list[str] | None = None) -> dict:
-    parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
-    parser.add_argument("--out", default="out", help="output folder (default: out/)")
-    parser.add_argument("--eps", type=float, default=0.02, help="paver precision ε (default 0.02)")
-    args = parser.parse_args(argv)
+    ap = parser(__doc__, eps=0.02)
+    args = ap.parse_args(argv)
     r = run(args.eps, args.out)
     print(
         f"Wire loop game at eps={r['eps']:g}: paving {r['pave_seconds']:.2f} s, "

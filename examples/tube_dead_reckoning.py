@@ -13,11 +13,11 @@ Usage: ``python examples/tube_dead_reckoning.py [--out DIR] [--minutes M]``.
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
+from _common import parser, report, save_figure
 
 from digslam.observer.tube.tube import (
     ctc_deriv,
@@ -105,7 +105,6 @@ def run(out: str | Path | None = None, minutes: float = 20.0, seed: int = 0) -> 
             INSIDE_COLOR,
             draw_boxes,
             new_figure,
-            save_figure,
         )
 
         fig, (ax0, axz, ax1) = new_figure(3, 1, size=4.5)
@@ -126,14 +125,18 @@ def run(out: str | Path | None = None, minutes: float = 20.0, seed: int = 0) -> 
         ax1.plot(t / 60, y.widths(), color=INSIDE_COLOR, label="with fixes")
         ax1.set_xlabel("time (min)"), ax1.set_ylabel("max gate width (m)"), ax1.legend(fontsize=7)
         ax1.set_title("(c) widths")
-        res["figure"] = str(save_figure(fig, Path(out) / "tube_dead_reckoning.png"))
+        res["figure"] = str(save_figure(fig, out, "tube_dead_reckoning.png"))
     return res
 
 
+def main(argv: list[str] | None = None) -> dict:
+    ap = parser(__doc__)
+    ap.add_argument("--minutes", type=float, default=20.0, help="mission length in min (default 20)")
+    a = ap.parse_args(argv)
+    r = run(a.out, a.minutes)
+    report(r)
+    return r
+
+
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--out", default="out")
-    ap.add_argument("--minutes", type=float, default=20.0)
-    a = ap.parse_args()
-    for key, val in run(a.out, a.minutes).items():
-        print(f"{key}: {val}")
+    main()

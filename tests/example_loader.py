@@ -1,4 +1,8 @@
-"""Import an example script by path (the examples are scripts, not a package)."""
+"""Import an example script by path (the examples are scripts, not a package).
+
+``examples/`` is added to ``sys.path`` before a script runs, as when it runs as ``python examples/<name>.py``,
+so that its ``from _common import ...`` finds ``examples/_common.py``.
+"""
 
 from __future__ import annotations
 
@@ -13,6 +17,8 @@ EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 def load(name: str) -> ModuleType:
     """Import ``examples/<name>.py`` (cached in ``sys.modules`` under a private name)."""
+    if str(EXAMPLES) not in sys.path:
+        sys.path.append(str(EXAMPLES))
     key = f"_digslam_example_{name}"
     if key in sys.modules:
         return sys.modules[key]

@@ -20,6 +20,20 @@ the truth without the simulator's code and checks that premise step by step:
   edge within reach as a cross-check of that computation. An echo interval must contain the exact distance;
   ``no_echo`` claims the exact distance exceeds ``r_max``. Readings flagged ``outlier`` are exempt (at most
   ``max_outliers`` of them per step when given).
+* **pymunk motion** (``truth.states`` non-empty): the truth is the piecewise-linear path through the stored
+  substep states ``(x, y, angle)`` (floats, exact), each substep lasting ``truth.taus[j]``. The checker
+  requires the first state to be the previous exact pose, the last the float pose (``pose_error = 0``), the
+  taus to be positive and to sum exactly to the record's time step, and, in exact arithmetic, every
+  substep's yaw rate ``(a_{j+1} - a_j) / tau_j`` (``Fraction``) inside ``record.yaw_rate`` and its
+  body-frame velocity ``R(-psi) u_j``, ``u_j = (p_{j+1} - p_j) / tau_j`` (``Fraction``), inside
+  ``record.speed x record.lateral`` for every heading ``psi`` between ``a_j`` and ``a_{j+1}``: the extremes
+  of each component over that range lie at its ends or where ``psi - atan2(u_y, u_x)`` is a multiple of
+  ``pi/2`` (:func:`velocity_extremes`, mpmath). A unicycle step (``truth.pieces``) has no lateral velocity:
+  ``record.lateral`` must contain 0.
+* **The disc** (when ``radius`` is given, pymunk steps): the robot's disc of that radius centred anywhere on
+  a substep segment keeps off every edge: the exact (``Fraction``) distance between the segment and each
+  edge is at least ``radius`` (:func:`segment_distance2`; edges farther than ``radius + 0.01`` in floats
+  are screened out).
 
 Use :class:`PremiseChecker` (``reset`` then ``step`` with each ``(record, truth)``), or :func:`check_episode`
 to drive an env through actions; both raise :class:`PremiseViolation` naming the step and the quantity.
@@ -29,6 +43,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from fractions import Fraction
 from typing import Any
 
 import mpmath
@@ -45,6 +60,14 @@ class PremiseViolation(AssertionError):
 def pieces(truth: Any) -> np.ndarray:
     """The step's pieces ``(2, 3)``, rows ``(v, tau, theta_end)`` (``truth.pieces``)."""
     return np.asarray(truth.pieces, dtype=np.float64)
+
+
+def path(truth: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    """The step's pymunk path ``(states (S + 1, 3), taus (S,))``, or None for a unicycle step."""
+    states = getattr(truth, "states", None)
+    if states is None or np.size(states) == 0:
+        return None
+    return np.asarray(states, dtype=np.float64), np.asarray(truth.taus, dtype=np.float64)
 
 
 def mpf(v: float) -> mpmath.mpf:
@@ -75,6 +98,50 @@ class ExactPose:
     def floats(self) -> np.ndarray:
         """Nearest float64 ``(x, y, th)``."""
         return np.array([float(self.x), float(self.y), self.th])
+
+
+def velocity_extremes(ux: Fraction, uy: Fraction, a0: float, a1: float) -> tuple[Any, Any, Any, Any]:
+    """``(min v1, max v1, min v2, max v2)`` (mp, :data:`PREC` bits) of the body-frame velocity
+    ``v1 = cos(psi) ux + sin(psi) uy``, ``v2 = cos(psi) uy - sin(psi) ux`` over ``psi`` between ``a0`` and
+    ``a1``: at the ends, or where ``psi - atan2(uy, ux)`` is a multiple of ``pi/2`` inside."""
+    with mpmath.workprec(PREC):
+        x, y = mpmath.mpf(ux.numerator) / ux.denominator, mpmath.mpf(uy.numerator) / uy.denominator
+        lo, hi = mpmath.mpf(min(a0, a1)), mpmath.mpf(max(a0, a1))
+        cands = [lo, hi]
+        if x != 0 or y != 0:
+            phi = mpmath.atan2(y, x)
+            k = mpmath.ceil((lo - phi) / (mpmath.pi / 2))
+            while phi + k * mpmath.pi / 2 <= hi:
+                cands.append(phi + k * mpmath.pi / 2)
+                k += 1
+        v1 = [mpmath.cos(p) * x + mpmath.sin(p) * y for p in cands]
+        v2 = [mpmath.cos(p) * y - mpmath.sin(p) * x for p in cands]
+        return min(v1), max(v1), min(v2), max(v2)
+
+
+def _point_segment2(q: tuple, a: tuple, b: tuple) -> Fraction:
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    dd = dx * dx + dy * dy
+    t = Fraction(0)
+    if dd:
+        t = min(max(((q[0] - a[0]) * dx + (q[1] - a[1]) * dy) / dd, Fraction(0)), Fraction(1))
+    ex, ey = a[0] + t * dx - q[0], a[1] + t * dy - q[1]
+    return ex * ex + ey * ey
+
+
+def _orient(a: tuple, b: tuple, c: tuple) -> int:
+    d = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+    return (d > 0) - (d < 0)
+
+
+def segment_distance2(p0: Any, p1: Any, e0: Any, e1: Any) -> Fraction:
+    """Exact squared distance between the closed segments ``p0 p1`` and ``e0 e1`` (float points): 0 when
+    they cross, else the least endpoint-to-segment distance."""
+    p0, p1, e0, e1 = (tuple(Fraction(float(c)) for c in q) for q in (p0, p1, e0, e1))
+    if _orient(e0, e1, p0) * _orient(e0, e1, p1) < 0 and _orient(p0, p1, e0) * _orient(p0, p1, e1) < 0:
+        return Fraction(0)
+    return min(_point_segment2(p0, e0, e1), _point_segment2(p1, e0, e1), _point_segment2(e0, p0, p1),
+               _point_segment2(e1, p0, p1))  # fmt: skip
 
 
 # --- exact cone distances ----------------------------------------------------------------------------------
@@ -186,11 +253,18 @@ class PremiseChecker:
         edges: The world's edges ``(E, 4)`` (``env.unwrapped.world.edges``).
         dense: Also cross-check the exact cone distances by dense sampling.
         max_outliers: If given, at most this many readings per step may be flagged ``outlier``.
+        radius: If given, check that the robot's disc of this radius keeps off every edge along each pymunk
+            substep segment.
+        ranges: Check the range readings (the expensive part); False checks the motion only.
     """
 
-    def __init__(self, edges: np.ndarray, dense: bool = True, max_outliers: int | None = None) -> None:
+    def __init__(self, edges: np.ndarray, dense: bool = True, max_outliers: int | None = None,
+                 radius: float | None = None, ranges: bool = True) -> None:  # fmt: skip
         self.edges = np.ascontiguousarray(edges, dtype=np.float64).reshape(-1, 4)
         self.dense, self.max_outliers = dense, max_outliers
+        self.radius, self.check_ranges = radius, ranges
+        #: pymunk substeps checked so far.
+        self.substeps = 0
         self.pose: ExactPose | None = None
         self.t = 0.0
         self.k = 0
@@ -200,8 +274,9 @@ class PremiseChecker:
         #: The same exactly: :class:`ExactPose` and mp distances.
         self.exact_poses: list[ExactPose] = []
         self.exact_ranges: list[list[Any]] = []
-        #: The pieces of each step after reset.
+        #: The pieces of each step after reset (unicycle) or its path ``(states, taus)`` (pymunk).
         self.pieces: list[np.ndarray] = []
+        self.paths: list[tuple[np.ndarray, np.ndarray]] = []
 
     def fail(self, msg: str) -> None:
         raise PremiseViolation(f"step {self.k}: {msg}")
@@ -211,30 +286,47 @@ class PremiseChecker:
         self.k = 0
         p = np.asarray(truth.pose, dtype=np.float64)
         self.pose = ExactPose(mpf(p[0]), mpf(p[1]), float(p[2]))
-        seg = pieces(truth)
-        if seg.shape != (2, 3):
-            self.fail(f"pieces: expected shape (2, 3), got {seg.shape}")
-        if np.any(seg[:, :2] != 0) or np.any(seg[:, 2] != p[2]):
-            self.fail(f"reset: pieces {seg.tolist()} should be at rest, at the start heading {p[2]!r}")
-        self.t = float(record.t)
+        pth = path(truth)
+        if pth is not None:
+            states, taus = pth
+            if np.any(states != p[None]) or np.any(taus != 0):
+                self.fail(
+                    f"reset: path {states.tolist()}, {taus.tolist()} should be at rest, at {p.tolist()}"
+                )
+        else:
+            seg = pieces(truth)
+            if seg.shape != (2, 3):
+                self.fail(f"pieces: expected shape (2, 3), got {seg.shape}")
+            if np.any(seg[:, :2] != 0) or np.any(seg[:, 2] != p[2]):
+                self.fail(f"reset: pieces {seg.tolist()} should be at rest, at the start heading {p[2]!r}")
+        self.t, self.substeps = float(record.t), 0
         self.poses, self.ranges, self.exact_poses, self.exact_ranges, self.pieces = [], [], [], [], []
-        for name in ("speed", "yaw_rate"):
+        self.paths = []
+        for name in ("speed", "yaw_rate", "lateral"):
             if not _within(mpf(0.0), getattr(record, name)):
                 self.fail(f"{name} interval {getattr(record, name).tolist()} misses 0 (robot at rest)")
         self._common(record, truth)
         return self.pose
 
     def step(self, record: Any, truth: Any) -> ExactPose:
-        """One step: advance the exact pose along ``truth.pieces`` and check ``record``."""
+        """One step: advance the exact pose along ``truth.pieces`` (unicycle) or ``truth.states`` (pymunk)
+        and check ``record``."""
         assert self.pose is not None, "reset first"
         self.k += 1
+        if float(truth.t) != float(record.t):
+            self.fail(f"truth.t {float(truth.t)!r} != record.t {float(record.t)!r}")
+        pth = path(truth)
+        if pth is not None:
+            self._step_path(record, *pth)
+            self._common(record, truth)
+            return self.pose
+        if not _within(mpf(0.0), record.lateral):
+            self.fail(f"lateral interval {record.lateral.tolist()} misses 0 (a unicycle does not slip)")
         seg = pieces(truth)
         if seg.shape != (2, 3) or not np.all(np.isfinite(seg)):
             self.fail(f"pieces: expected finite (2, 3), got {seg!r}")
         self.pieces.append(seg)
         t = float(record.t)
-        if float(truth.t) != t:
-            self.fail(f"truth.t {float(truth.t)!r} != record.t {t!r}")
         with mpmath.workprec(PREC):
             dt = mpmath.mpf(t) - mpmath.mpf(self.t)
             if np.any(seg[:, 1] < 0) or mpmath.mpf(seg[0, 1]) + mpmath.mpf(seg[1, 1]) != dt:
@@ -259,6 +351,70 @@ class PremiseChecker:
         self._common(record, truth)
         return self.pose
 
+    def _step_path(self, record: Any, states: np.ndarray, taus: np.ndarray) -> None:
+        """A pymunk step: the path starts at the exact pose, lasts exactly the record's time step, and every
+        substep's motion lies inside the record."""
+        assert self.pose is not None
+        n = len(taus)
+        if states.shape != (n + 1, 3) or not np.all(np.isfinite(states)) or not np.all(np.isfinite(taus)):
+            self.fail(
+                f"path: expected finite states (S + 1, 3) and taus (S,), got {states.shape}, {taus.shape}"
+            )
+        start = self.pose
+        with mpmath.workprec(PREC):
+            if not (
+                mpf(states[0, 0]) == start.x and mpf(states[0, 1]) == start.y and states[0, 2] == start.th
+            ):
+                self.fail(
+                    f"path starts at {states[0].tolist()}, not at the previous pose {start.floats().tolist()}"
+                )
+        t = float(record.t)
+        dt = Fraction(t) - Fraction(self.t)
+        if np.any(taus <= 0) or sum(Fraction(float(v)) for v in taus) != dt:
+            self.fail(
+                f"substep durations {taus.tolist()} do not sum exactly to t_k - t_(k-1) = {float(dt)!r}"
+            )
+        self.check_path(states, taus, record)
+        self.paths.append((states, taus))
+        self.pose = ExactPose(mpf(states[-1, 0]), mpf(states[-1, 1]), float(states[-1, 2]))
+        self.t = t
+
+    def check_path(self, states: np.ndarray, taus: np.ndarray, record: Any = None) -> None:
+        """Check each substep of a pymunk path in exact arithmetic: its yaw rate and body-frame velocity
+        inside ``record`` (when given), the disc's clearance (when the checker has a ``radius``)."""
+        for j in range(len(taus)):
+            self.substeps += 1
+            (x0, y0, a0), (x1, y1, a1) = states[j].tolist(), states[j + 1].tolist()
+            tau = Fraction(float(taus[j]))
+            if record is not None:
+                rate = (Fraction(a1) - Fraction(a0)) / tau
+                if not Fraction(float(record.yaw_rate[0])) <= rate <= Fraction(float(record.yaw_rate[1])):
+                    self.fail(f"substep {j}: yaw-rate interval {record.yaw_rate.tolist()} misses the exact rate "
+                              f"{float(rate)!r} (angle {a0!r} -> {a1!r} over {float(tau)!r} s)")  # fmt: skip
+                ux, uy = (Fraction(x1) - Fraction(x0)) / tau, (Fraction(y1) - Fraction(y0)) / tau
+                l1, h1, l2, h2 = velocity_extremes(ux, uy, a0, a1)
+                for name, lo, hi in (("speed", l1, h1), ("lateral", l2, h2)):
+                    iv = getattr(record, name)
+                    if not (_within(lo, iv) and _within(hi, iv)):
+                        self.fail(f"substep {j}: {name} interval {iv.tolist()} misses the exact body-frame "
+                                  f"velocity in [{mpmath.nstr(lo, 17)}, {mpmath.nstr(hi, 17)}]")  # fmt: skip
+            if self.radius is not None:
+                self._check_clearance(j, (x0, y0), (x1, y1))
+
+    def _check_clearance(self, j: int, p0: tuple[float, float], p1: tuple[float, float]) -> None:
+        r = float(self.radius)  # type: ignore[arg-type]
+        e = self.edges
+        # float screen: the distance from the segment's points to an edge is at least the distance from p0
+        # minus |p1 - p0|; edges farther than r + 0.01 that way cannot come within r (float error << 0.01)
+        length = math.hypot(p1[0] - p0[0], p1[1] - p0[1])
+        near = np.nonzero(_plain_dist(p0[0], p0[1], e) - length <= r + 0.01)[0]
+        r2 = Fraction(r) ** 2
+        for k in near:
+            d2 = segment_distance2(p0, p1, e[k, :2], e[k, 2:])
+            if d2 < r2:
+                self.fail(f"substep {j}: the disc of radius {r} on the segment {p0} -> {p1} overlaps edge "
+                          f"{e[k].tolist()} (distance {math.sqrt(float(d2))!r})")  # fmt: skip
+
     def _common(self, record: Any, truth: Any) -> None:
         p = np.asarray(truth.pose, dtype=np.float64)
         ex = self.pose
@@ -276,6 +432,10 @@ class PremiseChecker:
         flags = np.asarray(record.outlier, dtype=bool)
         if self.max_outliers is not None and int(flags.sum()) > self.max_outliers:
             self.fail(f"{int(flags.sum())} outliers in one step, above the stated {self.max_outliers}")
+        if not self.check_ranges:
+            self.poses.append(ex.floats())
+            self.exact_poses.append(ex)
+            return
         rng = np.asarray(record.range, dtype=np.float64)
         r_max = np.asarray(record.r_max, dtype=np.float64)
         hi = np.where(np.isfinite(rng[:, 1]), rng[:, 1], 0.0)
@@ -299,12 +459,13 @@ class PremiseChecker:
                           f"{mpmath.nstr(ds, 20)} (no_echo={bool(record.no_echo[s])})")  # fmt: skip
 
 
-def check_episode(env: Any, seed: int, actions: Any, dense: bool = True,
-                  max_outliers: int | None = None) -> PremiseChecker:  # fmt: skip
+def check_episode(env: Any, seed: int, actions: Any, dense: bool = True, max_outliers: int | None = None,
+                  radius: float | None = None, ranges: bool = True) -> PremiseChecker:  # fmt: skip
     """Reset ``env`` (raw or wrapped) with ``seed``, run ``actions`` (float64, so subnormal yaw actions
     survive) and check every step's record; returns the checker (its ``poses`` and ``ranges``)."""
     _, info = env.reset(seed=seed)
-    chk = PremiseChecker(env.unwrapped.world.edges, dense=dense, max_outliers=max_outliers)
+    chk = PremiseChecker(env.unwrapped.world.edges, dense=dense, max_outliers=max_outliers, radius=radius,
+                         ranges=ranges)  # fmt: skip
     chk.reset(info["record"], info["truth"])
     for a in actions:
         _, _, term, trunc, info = env.step(np.asarray(a, dtype=np.float64))

@@ -37,7 +37,7 @@ def _observer() -> None:
     import gymnasium as gym
 
     import digslam.envs  # noqa: F401
-    from digslam.agents.cli.main import DEFAULT_ENV, model_env_kwargs
+    from digslam.agents.learning.models import DEFAULT_ENV, model_env_kwargs
 
     env = gym.make(DEFAULT_ENV, **model_env_kwargs())
     env.reset(seed=0)

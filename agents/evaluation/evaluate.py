@@ -131,7 +131,7 @@ class EvalResult:
             raise ValueError(f"path: {path} is not an EvalResult JSON (missing {exc})") from None
 
 
-def _make_env(env_id: str, steps: int, env_kwargs: dict[str, Any] | None, render: bool = False) -> Any:
+def make_env(env_id: str, steps: int, env_kwargs: dict[str, Any] | None, render: bool = False) -> Any:
     import gymnasium as gym
 
     import digslam.envs  # noqa: F401  (registers the environments)
@@ -197,7 +197,7 @@ def evaluate(
         bar = tqdm(total=len(policies) * n_maps, desc="evaluate", unit="episode")
     out: dict[str, dict[str, np.ndarray]] = {k: {} for k in ("c", "t", "b", "w", "n")}
     for name, policy in policies.items():
-        env = _make_env(env_id, steps, env_kwargs)
+        env = make_env(env_id, steps, env_kwargs)
         try:
             rows = []
             for i in range(n_maps):
@@ -268,33 +268,11 @@ def coverage_figure(result: EvalResult, path: str | Path, target: float | None =
     return p
 
 
-def record_episode_gif(
-    policy: Any,
-    env_id: str = "digslam/DigCoverage-v0",
-    path: str | Path = "episode.gif",
-    steps: int = 300,
-    seed: int = 0,
-    env_kwargs: dict[str, Any] | None = None,
-    fps: int = 15,
-    stride: int = 1,
-    scale: int = 1,
-) -> Path:
-    """Animated GIF of one episode of ``policy``: the frames of :mod:`.pictures` (the observer's sets in a
-    colour-blind-safe palette, a legend in the thesis's words, the step, both coverages and the tube width;
-    :func:`~.pictures.demo_episode`). ``stride`` keeps every ``stride``-th frame and ``scale`` shrinks
-    each frame by that factor (file size)."""
-    from digslam.agents.evaluation.pictures import demo_episode
-
-    demo_episode(policy, env_id, path, steps=steps, seed=seed, env_kwargs=env_kwargs, fps=fps, stride=stride,
-                 scale=scale)  # fmt: skip
-    return Path(path)
-
-
 __all__ = [
     "EVAL_DEFAULTS",
     "EvalResult",
     "coverage_figure",
     "evaluate",
-    "record_episode_gif",
+    "make_env",
     "run_episode",
 ]

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from digslam.agents.evaluation.evaluate import EvalResult, make_env
 from digslam.envs.dig_coverage.env import RGB
 from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
 
@@ -207,12 +208,10 @@ def demo_episode(
     """Run one episode of ``policy``, write its GIF to ``path`` (every ``stride``-th step and the last, each
     frame shrunk ``scale`` times) and return its :class:`~digslam.agents.evaluation.evaluate.EvalResult` (one
     episode, curves padded after an early end, ``lengths`` the steps run)."""
-    from digslam.agents.evaluation.evaluate import EvalResult, _make_env
-
     for key, v in (("steps", steps), ("fps", fps), ("stride", stride), ("scale", scale)):
         if not (isinstance(v, int) and v >= 1):
             raise ValueError(f"{key}: must be an integer >= 1, got {v!r}")
-    env = _make_env(env_id, steps, env_kwargs)
+    env = make_env(env_id, steps, env_kwargs)
     if hasattr(policy, "reset") and callable(policy.reset) and not hasattr(policy, "policy"):
         policy.reset()
     cert, true = np.empty(steps + 1), np.empty(steps + 1)
@@ -257,4 +256,33 @@ def write_gif(frames: list[Any], path: str | Path, fps: int) -> Path:
     return p
 
 
-__all__ = ["LEGEND", "MAP_SIZE", "PALETTE", "PANEL_WIDTH", "FrameDrawer", "demo_episode", "write_gif"]
+def record_episode_gif(
+    policy: Any,
+    env_id: str = "digslam/DigCoverage-v0",
+    path: str | Path = "episode.gif",
+    steps: int = 300,
+    seed: int = 0,
+    env_kwargs: dict[str, Any] | None = None,
+    fps: int = 15,
+    stride: int = 1,
+    scale: int = 1,
+) -> Path:
+    """Animated GIF of one episode of ``policy``: the frames of :mod:`.pictures` (the observer's sets in a
+    colour-blind-safe palette, a legend in the thesis's words, the step, both coverages and the tube width;
+    :func:`demo_episode`). ``stride`` keeps every ``stride``-th frame and ``scale`` shrinks
+    each frame by that factor (file size)."""
+    demo_episode(policy, env_id, path, steps=steps, seed=seed, env_kwargs=env_kwargs, fps=fps, stride=stride,
+                 scale=scale)  # fmt: skip
+    return Path(path)
+
+
+__all__ = [
+    "record_episode_gif",
+    "LEGEND",
+    "MAP_SIZE",
+    "PALETTE",
+    "PANEL_WIDTH",
+    "FrameDrawer",
+    "demo_episode",
+    "write_gif",
+]

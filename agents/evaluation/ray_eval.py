@@ -27,13 +27,14 @@ ValueError: policies_spec: 'x' -> 'no_such_agent' is neither a baseline (...) no
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from digslam.agents.learning import models
 
 #: Baseline names accepted as specs (mirrors ``digslam.agents.baselines.registry.BASELINES``; checked in the
 #: worker).
@@ -194,35 +195,29 @@ def evaluate_ray(
     return merge_results(parts, seed, n_maps)
 
 
-def add_cli(parser: argparse.ArgumentParser) -> Callable[[argparse.Namespace], Any]:
-    """Add ``--ray``, ``--address`` and ``--ray-cpus`` to the ``evaluate`` sub-parser; return its handler.
+def agent_specs(
+    agents: Sequence[str], model: str | Path | None = None
+) -> tuple[dict[str, str], dict[str, Any]]:
+    """``(specs, env_kwargs)`` for :func:`evaluate_ray` from agent names (what ``digslam evaluate --ray``
+    takes): ``"ppo"`` is the saved model ``model`` (None: the shipped policy), whose sidecar gives the
+    environment keywords; any other agent is a baseline name.
 
-    The handler (also stored as the parser default ``ray_evaluate``) takes the parsed ``evaluate``
-    arguments (``agents``, ``model``, ``env``, ``maps``, ``seed``, ``steps``) and returns the
-    ``EvalResult`` of :func:`evaluate_ray`: ``"ppo"`` is the ``--model`` path (default the shipped policy,
-    with the environment keywords of its sidecar), any other agent a baseline name.
+    Raises:
+        FileNotFoundError: ``"ppo"`` is among the agents and there is no model file.
     """
-    parser.add_argument("--ray", action="store_true", help="distribute the episodes over Ray (one task each)")
-    parser.add_argument(
-        "--address", default=None, help="Ray cluster to attach to (e.g. auto, host:6379); default: local"
-    )
-    parser.add_argument("--ray-cpus", type=int, default=None, help="CPUs of the local Ray instance")
-
-    def handler(args: argparse.Namespace) -> Any:
-        from digslam.agents.cli.main import PRETRAINED, model_env_kwargs
-
-        if (args.address is not None or args.ray_cpus is not None) and not args.ray:
-            raise ValueError("--address/--ray-cpus: only with --ray")
-        model = Path(args.model) if args.model else PRETRAINED
-        if "ppo" in args.agents and not model.is_file():
-            raise FileNotFoundError(f"model: no saved policy at {str(model)!r}")
-        specs = {a: (str(model) if a == "ppo" else a) for a in args.agents}
-        kwargs = model_env_kwargs(model) if "ppo" in specs else {}
-        return evaluate_ray(specs, env_id=args.env, n_maps=args.maps, seed=args.seed, steps=args.steps,
-                            env_kwargs=kwargs, address=args.address, num_cpus=args.ray_cpus)  # fmt: skip
-
-    parser.set_defaults(ray_evaluate=handler)
-    return handler
+    path = Path(model) if model else models.PRETRAINED
+    if "ppo" in agents and not path.is_file():
+        raise FileNotFoundError(f"model: no saved policy at {str(path)!r}")
+    specs = {a: (str(path) if a == "ppo" else a) for a in agents}
+    return specs, (models.model_env_kwargs(path) if "ppo" in specs else {})
 
 
-__all__ = ["add_cli", "build_policy", "evaluate_ray", "merge_results", "normalize_specs", "evaluate_one"]
+__all__ = [
+    "agent_specs",
+    "build_policy",
+    "evaluate_one",
+    "evaluate_ray",
+    "merge_results",
+    "normalize_specs",
+    "start_ray",
+]

@@ -13,15 +13,14 @@ Results land in ``<storage_path>/<name>/``: Tune's experiment state (what :func:
 ``resume=True`` restores with ``Tuner.restore``), ``models/<trial id>/`` (each trial's ``out_dir``: final
 and best-coverage models, config, TensorBoard logs) and ``results.csv`` plus the markdown table returned.
 
-The configuration lives in :mod:`.sweep_config`.
+The configuration lives in :mod:`.sweep_config`; the ``digslam sweep`` command in
+:mod:`digslam.agents.cli.distributed`.
 """
 
 from __future__ import annotations
 
-import argparse
 import functools
 from collections.abc import Callable
-from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -39,7 +38,7 @@ def sweep_trial(params: dict[str, Any], sweep: dict[str, Any]) -> None:
 
     cfg = SweepConfig.from_dict(sweep)
     base = cfg.base_config()
-    data = asdict(base)
+    data = base.to_dict()
     params = dict(params)
     data["env_kwargs"] = {**data["env_kwargs"], **params.pop("env_kwargs", {})}
     data.update(params)
@@ -258,27 +257,13 @@ def _write_csv(rows: list[dict[str, Any]], path: str) -> Path:
     return out
 
 
-def add_cli(subparsers: Any) -> Callable[[argparse.Namespace], int]:
-    """Add ``sweep CONFIG [--address A] [--resume] [--num-cpus N]`` to ``subparsers``; return the handler
-    (also set as the parser's ``func`` default), which prints the table and the CSV path and returns 0."""
-    p = subparsers.add_parser("sweep", help="hyper-parameter and seed sweep of the PPO recipe on Ray Tune")
-    p.add_argument(
-        "config", help="sweep configuration (.toml or .json), see agents/configs/sweep_example.toml"
-    )
-    p.add_argument("--address", default=None, help="Ray cluster to attach to (e.g. auto); default: local")
-    p.add_argument("--resume", action="store_true", help="restore an interrupted sweep of the same name")
-    p.add_argument("--num-cpus", type=int, default=None, help="CPUs of the local Ray instance")
-
-    def handler(args: argparse.Namespace) -> int:
-        table, csv_path = run_sweep(SweepConfig.from_file(args.config), address=args.address,
-                                    resume=args.resume, num_cpus=args.num_cpus)  # fmt: skip
-        print(table)
-        print(f"results: {csv_path}")
-        return 0
-
-    p.set_defaults(func=handler)
-    return handler
-
-
-__all__ = ["FIXED_KEYS", "SPACE_KINDS", "SweepConfig", "add_cli", "evaluate_coverage",
-           "results_table", "run_sweep", "sweep_trial", "train_with_callback"]  # fmt: skip
+__all__ = [
+    "FIXED_KEYS",
+    "SPACE_KINDS",
+    "SweepConfig",
+    "evaluate_coverage",
+    "results_table",
+    "run_sweep",
+    "sweep_trial",
+    "train_with_callback",
+]

@@ -14,11 +14,12 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import field, fields
 from pathlib import Path
 from typing import Any
 
 from digslam.agents.learning.train import TrainConfig
+from digslam.observer.core.config import Config, config_dataclass, reject_unknown
 
 try:
     import tomllib
@@ -31,8 +32,8 @@ SPACE_KINDS = ("grid", "choice", "uniform", "loguniform", "randint")
 FIXED_KEYS = ("seed", "out_dir")
 
 
-@dataclass(frozen=True)
-class SweepConfig:
+@config_dataclass
+class SweepConfig(Config):
     """A Ray Tune sweep of :func:`~digslam.agents.learning.train.train` (see the module docstring).
 
     Attributes:
@@ -111,14 +112,14 @@ class SweepConfig:
 
     # --- construction -------------------------------------------------------------------------------------
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any], root: str | Path | None = None) -> SweepConfig:
-        """Build from a mapping; unknown keys raise ``ValueError``. A relative ``base`` path is taken from
-        the working directory, else from ``root`` (the sweep file's folder), and made absolute."""
-        known = {f.name for f in fields(cls)}
-        unknown = sorted(set(data) - known)
-        if unknown:
-            raise ValueError(f"SweepConfig: unknown key(s) {unknown}; known: {sorted(known)}")
-        data = dict(data)
+    def from_dict(
+        cls, data: Mapping[str, Any] | None = None, root: str | Path | None = None, **kwargs: Any
+    ) -> SweepConfig:
+        """Build from a mapping and keyword overrides; unknown keys raise ``ValueError``. A relative ``base``
+        path is taken from the working directory, else from ``root`` (the sweep file's folder), and made
+        absolute."""
+        data = {**(data or {}), **kwargs}
+        reject_unknown(cls, data)
         base = data.get("base")
         if isinstance(base, str):  # absolute: trials run in other working directories
             near = Path(root) / base if root is not None else Path(base)
@@ -181,7 +182,7 @@ class SweepConfig:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data (JSON-able)."""
-        d = asdict(self)
+        d = super().to_dict()
         d["seeds"] = list(self.seeds)
         return d
 

@@ -20,7 +20,6 @@ ValueError: TrainConfig: unknown key(s) ['n_env']; known: ...
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import os
 import signal
@@ -32,6 +31,8 @@ from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
+
+from digslam.observer.core.config import Config, config_dataclass
 
 try:
     import tomllib
@@ -46,8 +47,8 @@ def _default_env_kwargs() -> dict[str, Any]:
     return {"map_size": 36, "crop": 4.0, "fixed_world": False}
 
 
-@dataclass(frozen=True)
-class TrainConfig:
+@config_dataclass
+class TrainConfig(Config):
     """A PPO training run (all fields type-checked; see the module docstring).
 
     Attributes:
@@ -125,16 +126,7 @@ class TrainConfig:
         """Seeds of the held-out evaluation maps."""
         return tuple(range(self.eval_seed, self.eval_seed + self.eval_maps))
 
-    # --- construction -------------------------------------------------------------------------------------
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> TrainConfig:
-        """Build from a mapping; unknown keys raise ``ValueError`` naming them."""
-        known = {f.name for f in fields(cls)}
-        unknown = sorted(set(data) - known)
-        if unknown:
-            raise ValueError(f"TrainConfig: unknown key(s) {unknown}; known: {sorted(known)}")
-        return cls(**dict(data))
-
+    # --- construction (``from_dict``, ``replace`` and ``to_dict`` come from the config base) ----------------
     @classmethod
     def from_file(cls, path: str | Path | None = None, overrides: Iterable[str] = ()) -> TrainConfig:
         """Read a ``.toml`` or ``.json`` file (None: :data:`DEFAULT_CONFIG`), then apply ``overrides``."""
@@ -154,7 +146,7 @@ class TrainConfig:
 
     def override(self, overrides: Iterable[str]) -> TrainConfig:
         """Apply ``key=value`` strings (values parsed as TOML literals, else taken as strings)."""
-        data = dataclasses.asdict(self)
+        data = self.to_dict()
         for item in overrides:
             key, sep, raw = item.partition("=")
             key = key.strip()
@@ -305,7 +297,7 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = N
     pin_threads(cfg.torch_threads)
     out = Path(cfg.out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "config.json").write_text(json.dumps(dataclasses.asdict(cfg), indent=2))
+    (out / "config.json").write_text(json.dumps(cfg.to_dict(), indent=2))
     try:
         import tensorboard  # noqa: F401
 

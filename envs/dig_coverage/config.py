@@ -1,7 +1,8 @@
 """Frozen, validated configuration of the observer wrapper and of the certified-coverage environments.
 
-Like :mod:`.config`, every config is a frozen dataclass whose constructor and :meth:`from_dict` reject unknown
-keys with a ``ValueError`` naming them, and whose values are checked with the offending field named.
+Like :mod:`digslam.envs.config`, every config is a frozen dataclass on the project's config base
+(:mod:`digslam.observer.core.config`): its constructor and :meth:`from_dict` reject unknown keys with a
+``ValueError`` naming them, and its values are checked with the offending field named.
 
 >>> ObserverConfig(map_size=48).map_size
 48
@@ -15,10 +16,18 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import field, replace
+from dataclasses import field
 from typing import Any
 
-from digslam.envs.config import ExploreConfig, _check, _Config, config_dataclass
+from digslam.envs.config import ExploreConfig
+from digslam.observer.core.config import (
+    Config,
+    check,
+    check_finite_nonneg,
+    check_in,
+    check_int,
+    config_dataclass,
+)
 from digslam.observer.online.observer import OnlineConfig
 
 #: Smallest image side SB3's ``NatureCNN`` accepts (three valid convolutions of 8/4, 4/2 and 3/1).
@@ -26,7 +35,7 @@ NATURE_CNN_MIN = 36
 
 
 @config_dataclass
-class ObserverConfig(_Config):
+class ObserverConfig(Config):
     """Settings of :class:`~digslam.envs.dig_coverage.wrapper.GuaranteedObserver`.
 
     Attributes:
@@ -62,66 +71,56 @@ class ObserverConfig(_Config):
     def __post_init__(self) -> None:
         if isinstance(self.online, Mapping):
             object.__setattr__(self, "online", OnlineConfig.from_dict(self.online))
-        _check(isinstance(self.online, OnlineConfig), "online", "must be an OnlineConfig or a mapping")
+        check(isinstance(self.online, OnlineConfig), "online", "must be an OnlineConfig or a mapping")
         q = self.q
-        _check(
-            isinstance(q, int) and not isinstance(q, bool) and q >= 0,
-            "q",
-            f"must be an integer >= 0 (outliers allowed per step), got {q!r}",
-        )
-        _check(
+        check_int("q", q, 0, " (outliers allowed per step)")
+        check(
             not (q and self.online.q and q != self.online.q),
             "q",
             f"{q} disagrees with online.q = {self.online.q}",
         )
         if q and not self.online.q:
-            object.__setattr__(self, "online", replace(self.online, q=q))
+            object.__setattr__(self, "online", self.online.replace(q=q))
         object.__setattr__(self, "q", self.online.q)
         c = self.grid_cell
-        _check(
+        check(
             isinstance(c, (int, float)) and math.isfinite(c) and c > 0,
             "grid_cell",
             f"cell size must be finite and > 0, got {c!r}",
         )
         m = self.map_size
-        _check(isinstance(m, int) and m >= 1, "map_size", f"must be a positive integer, got {m!r}")
-        _check(
+        check(isinstance(m, int) and m >= 1, "map_size", f"must be a positive integer, got {m!r}")
+        check(
             m >= NATURE_CNN_MIN or self.custom_extractor,
             "map_size",
             f"{m} is below {NATURE_CNN_MIN}, the smallest image SB3's NatureCNN accepts; declare "
             "custom_extractor=True to use a custom features extractor",
         )
         if self.crop is not None:
-            _check(
+            check(
                 isinstance(self.crop, (int, float)) and math.isfinite(self.crop) and self.crop > 0,
                 "crop",
                 f"must be None or a crop side > 0 (m), got {self.crop!r}",
             )
         if self.grid_frame is not None:
             f = tuple(float(v) for v in self.grid_frame)
-            _check(
+            check(
                 len(f) == 4 and all(math.isfinite(v) for v in f) and f[0] < f[2] and f[1] < f[3],
                 "grid_frame",
                 f"must be a finite (xmin, ymin, xmax, ymax) with xmin < xmax and ymin < ymax, got {f}",
             )
-            _check(
+            check(
                 math.isclose(f[2] - f[0], f[3] - f[1], rel_tol=1e-9),
                 "grid_frame",
                 f"must be square (square cells), got {f}",
             )
             object.__setattr__(self, "grid_frame", f)
-        _check(
-            isinstance(self.start_box, (int, float))
-            and math.isfinite(self.start_box)
-            and self.start_box >= 0,
-            "start_box",
-            f"must be finite and >= 0, got {self.start_box!r}",
-        )
-        _check(isinstance(self.horizon, int) and self.horizon >= 1, "horizon", f"invalid {self.horizon!r}")
+        check_finite_nonneg("start_box", self.start_box)
+        check(isinstance(self.horizon, int) and self.horizon >= 1, "horizon", f"invalid {self.horizon!r}")
 
 
 @config_dataclass
-class DigCoverageConfig(_Config):
+class DigCoverageConfig(Config):
     """Settings of ``digslam/DigCoverage-v0`` (the reward and termination; the rest lives in ``observer``
     and ``explore``).
 
@@ -142,16 +141,10 @@ class DigCoverageConfig(_Config):
             object.__setattr__(self, "observer", ObserverConfig.from_dict(self.observer))
         if isinstance(self.explore, Mapping):
             object.__setattr__(self, "explore", ExploreConfig.from_dict(self.explore))
-        _check(
-            isinstance(self.observer, ObserverConfig), "observer", "must be an ObserverConfig or a mapping"
-        )
-        _check(isinstance(self.explore, ExploreConfig), "explore", "must be an ExploreConfig or a mapping")
-        _check(0.0 < self.target <= 1.0, "target", f"must be in (0, 1], got {self.target!r}")
-        _check(
-            math.isfinite(self.collision_penalty) and self.collision_penalty >= 0,
-            "collision_penalty",
-            f"must be finite and >= 0, got {self.collision_penalty!r}",
-        )
+        check(isinstance(self.observer, ObserverConfig), "observer", "must be an ObserverConfig or a mapping")
+        check(isinstance(self.explore, ExploreConfig), "explore", "must be an ExploreConfig or a mapping")
+        check_in("target", self.target, 0.0, 1.0, lo_open=True)
+        check_finite_nonneg("collision_penalty", self.collision_penalty)
 
     @classmethod
     def split(cls, kwargs: Mapping[str, Any]) -> DigCoverageConfig:

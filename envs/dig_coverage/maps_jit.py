@@ -27,11 +27,12 @@ from __future__ import annotations
 import math
 from bisect import bisect_left, bisect_right
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 
+from digslam.observer.core.grid_jit import window
 from digslam.observer.core.scalar_jit import njit
-from digslam.observer.online.dig_jit import window
 from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
 
 _CLEAR, _PENUMBRA, _DARK = int(CLEAR), int(PENUMBRA), int(DARK)
@@ -50,14 +51,79 @@ def _bounds(n: int, m: int) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
     return s, e, tuple(s.tolist())
 
 
+class PixelBlocks(NamedTuple):
+    """The cell blocks of the map's pixels (:func:`pixel_blocks`): pixel ``(p, q)`` covers the rows
+    ``row_start[p] : row_end[p]`` and the columns ``col_start[q] : col_end[q]``; each field ``(m,)`` int64.
+    """
+
+    row_start: np.ndarray
+    row_end: np.ndarray
+    col_start: np.ndarray
+    col_end: np.ndarray
+
+
+class MapPlanes(NamedTuple):
+    """The per-cell sets the map is drawn from, each ``(ny, nx)`` with one byte per cell (kept up to date on
+    the cells a step changed).
+
+    Attributes:
+        explored: the explored codes (int8 ``CLEAR``, ``PENUMBRA``, ``DARK``, or their uint8 bytes).
+        clear: the clear mask (certainly sensed and proved free; bool or uint8 0 / 1).
+        dark: the dark mask (certainly not sensed).
+        reach: the reachable free cells (the certified count is taken over them).
+    """
+
+    explored: np.ndarray
+    clear: np.ndarray
+    dark: np.ndarray
+    reach: np.ndarray
+
+
+class MapContext(NamedTuple):
+    """What :func:`observe` reads and keeps between steps, built once per episode by :func:`map_context`
+    (flat on purpose: each field, and each nested tuple more, costs at every call from Python).
+
+    Attributes:
+        sure, maybe, free: ``(ny, nx)`` bool, the filter's certainly and possibly sensed cells and ``M⁻``
+            (read: the filter's own arrays).
+        explored, clear, dark, reach: the map's cell sets, ``(ny, nx)`` uint8 planes (:class:`MapPlanes`),
+            kept up to date on the cells a step changed.
+        base: ``(3, m, m)`` uint8, the clear / penumbra / dark channels of the map, kept between steps.
+        row_start, row_end, col_start, col_end: the pixel blocks (:class:`PixelBlocks`).
+        xs, nys: the grid's exact cell bounds (``nys = -ys``), for the pose-box channel; the state is
+            normalised over the grid's frame ``[xs[0], xs[-1]] × [-nys[-1], -nys[0]]``.
+        horizon: the episode's step horizon (the state's elapsed-steps value is ``steps / horizon``).
+        n_reach: the number of reachable free cells (the certified fraction's denominator).
+    """
+
+    sure: np.ndarray
+    maybe: np.ndarray
+    free: np.ndarray
+    explored: np.ndarray
+    clear: np.ndarray
+    dark: np.ndarray
+    reach: np.ndarray
+    base: np.ndarray
+    row_start: np.ndarray
+    row_end: np.ndarray
+    col_start: np.ndarray
+    col_end: np.ndarray
+    xs: np.ndarray
+    nys: np.ndarray
+    horizon: float
+    n_reach: int
+
+
 @njit
-def _fill(clear: np.ndarray, dark: np.ndarray, img: np.ndarray, ch: int, rs: np.ndarray, re: np.ndarray,
-          cs: np.ndarray, ce: np.ndarray, p0: int, p1: int, q0: int, q1: int) -> None:  # fmt: skip
-    """Pixels ``[p0:p1, q0:q1]`` of channels ``ch, ch + 1, ch + 2`` of ``img`` (255 / 0): all clear, mixed,
-    all dark per pixel block. The masks come as ``uint8`` views; each block row is first AND-reduced
-    over its cells' rows."""
+def _fill(clear: np.ndarray, dark: np.ndarray, img: np.ndarray, ch: int, blocks: PixelBlocks,
+          pix: tuple[int, int, int, int]) -> None:  # fmt: skip
+    """Pixels ``pix = (p0, p1, q0, q1)`` (rows ``p0:p1``, columns ``q0:q1``) of channels ``ch, ch + 1,
+    ch + 2`` of ``img`` (255 / 0): all clear, mixed, all dark per pixel block. The masks come as ``uint8``
+    views; each block row is first AND-reduced over its cells' rows."""
+    p0, p1, q0, q1 = pix
     if p0 >= p1 or q0 >= q1:
         return
+    rs, re, cs, ce = blocks.row_start, blocks.row_end, blocks.col_start, blocks.col_end
     j0, j1 = cs[q0], ce[q1 - 1]
     w = j1 - j0
     ac, ad = np.empty(w, np.uint8), np.empty(w, np.uint8)
@@ -87,11 +153,9 @@ def _fill(clear: np.ndarray, dark: np.ndarray, img: np.ndarray, ch: int, rs: np.
 
 def fill_map(clear: np.ndarray, dark: np.ndarray, img: np.ndarray, ch: int = 0) -> None:
     """Write the clear / penumbra / dark pixel masks of the cell masks into ``img[ch : ch + 3]`` (0 / 255)."""
-    m = img.shape[-1]
-    rs, re, _ = _bounds(clear.shape[0], m)
-    cs, ce, _ = _bounds(clear.shape[1], m)
+    blocks = pixel_blocks(clear.shape, img.shape[-1])
     u8 = [np.ascontiguousarray(v).view(np.uint8) for v in (clear, dark)]
-    _fill(u8[0], u8[1], img, ch, rs, re, cs, ce, 0, rs.size, 0, cs.size)
+    _fill(u8[0], u8[1], img, ch, blocks, (0, blocks.row_start.size, 0, blocks.col_start.size))
 
 
 def three_state(clear: np.ndarray, dark: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -107,12 +171,19 @@ def all_blocks(mask: np.ndarray, m: int) -> np.ndarray:
 
 
 @njit
-def _sets(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, reach: np.ndarray, explored: np.ndarray,
-          clear: np.ndarray, dark: np.ndarray, r0: int, r1: int, c0: int, c1: int) -> int:  # fmt: skip
-    """The cells ``[r0:r1, c0:c1]`` of the sets; returns the change of the clear cells inside ``reach``."""
+def _sets(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, planes: MapPlanes,
+          win: tuple[int, int, int, int]) -> int:  # fmt: skip
+    """The cells ``win = (r0, r1, c0, c1)`` of ``planes``; returns the change of the clear cells inside
+    ``planes.reach``."""
+    r0, r1, c0, c1 = win
     n = 0
-    s8, m8, f8, r8 = sure.view(np.uint8), maybe.view(np.uint8), free.view(np.uint8), reach.view(np.uint8)
-    e8, c8, d8 = explored.view(np.uint8), clear.view(np.uint8), dark.view(np.uint8)
+    s8, m8, f8, r8 = (
+        sure.view(np.uint8),
+        maybe.view(np.uint8),
+        free.view(np.uint8),
+        planes.reach.view(np.uint8),
+    )
+    e8, c8, d8 = planes.explored.view(np.uint8), planes.clear.view(np.uint8), planes.dark.view(np.uint8)
     one, code_dark = np.uint8(1), np.uint8(_DARK & 0xFF)
     for i in range(r0, r1):  # row slices: indices from 0, so no wraparound checks (the loops vectorize)
         s_, m_, f_, r_ = s8[i, c0:c1], m8[i, c0:c1], f8[i, c0:c1], r8[i, c0:c1]
@@ -130,64 +201,59 @@ def _sets(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, reach: np.ndarr
 
 
 @njit
-def _sets_and_map(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, reach: np.ndarray,
-                  explored: np.ndarray, clear: np.ndarray, dark: np.ndarray, img: np.ndarray, rs: np.ndarray,
-                  re: np.ndarray, cs: np.ndarray, ce: np.ndarray, r0: int, r1: int, c0: int, c1: int,
-                  p0: int, p1: int, q0: int, q1: int) -> int:  # fmt: skip
-    n = _sets(sure, maybe, free, reach, explored, clear, dark, r0, r1, c0, c1)
-    _fill(clear.view(np.uint8), dark.view(np.uint8), img, 0, rs, re, cs, ce, p0, p1, q0, q1)
+def _sets_and_map(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, planes: MapPlanes, img: np.ndarray,
+                  blocks: PixelBlocks, win: tuple[int, int, int, int]) -> int:  # fmt: skip
+    """:func:`sets_and_map` (compiled): :func:`_sets` of ``win``, then :func:`_fill` of its pixels."""
+    r0, r1, c0, c1 = win
+    ny, nx = sure.shape
+    n = _sets(sure, maybe, free, planes, win)
+    pix = (*_pixels(blocks.row_start, r0, r1, ny), *_pixels(blocks.col_start, c0, c1, nx))
+    _fill(planes.clear.view(np.uint8), planes.dark.view(np.uint8), img, 0, blocks, pix)
     return n
 
 
 @njit
-def _right(s: np.ndarray, v: int) -> int:
-    """``bisect_right(s, v)`` on the increasing int array ``s``."""
-    lo, hi = 0, s.size
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if s[mid] <= v:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
-
-
-@njit
 def _pixels(s: np.ndarray, r0: int, r1: int, n: int) -> tuple[int, int]:
-    """:func:`pixel_range` on the block starts ``s`` (compiled twin, same result)."""
+    """:func:`pixel_range` on the block starts ``s`` (compiled twin, same result): ``np.searchsorted`` with
+    ``side="right"`` is ``bisect_right`` and ``side="left"`` is ``bisect_left``."""
     if r0 >= r1:
         return 0, 0
     m = s.size
-    p0 = _right(s, r0) - 1
-    p1 = _right(s, r1 - 1)
+    p0 = np.searchsorted(s, r0, side="right") - 1
+    p1 = np.searchsorted(s, r1 - 1, side="right")
     if n < m:  # several pixels share a cell: take them all (bisect_left(s, s[p0]))
-        v = s[p0]
-        lo, hi = 0, m
-        while lo < hi:
-            mid = (lo + hi) // 2
-            if s[mid] < v:
-                lo = mid + 1
-            else:
-                hi = mid
-        p0 = lo
+        p0 = np.searchsorted(s, s[p0], side="left")
     return max(p0, 0), min(p1, m)
 
 
 @njit
-def _observe(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, planes: np.ndarray, base: np.ndarray,
-             img: np.ndarray, blocks: np.ndarray, r0: int, r1: int, c0: int, c1: int, xs: np.ndarray,
-             nys: np.ndarray, lo: np.ndarray, hi: np.ndarray, h0: float, h1: float, norm: np.ndarray,
-             steps: int, n_reach: int, n_prev: int, state: np.ndarray, snap: np.ndarray) -> int:  # fmt: skip
-    """:func:`observe` (``planes`` ``(4, ny, nx)`` uint8: explored, clear, dark, reach; ``blocks``
-    ``(4, m)``: the pixel block bounds ``rs, re, cs, ce`` of :func:`_bounds`)."""
+def observe(maps: MapContext, pose_lo: np.ndarray, pose_hi: np.ndarray, heading: tuple[float, float],
+            win: tuple[int, int, int, int], steps: int, n_prev: int, img: np.ndarray, state: np.ndarray,
+            snap: np.ndarray) -> int:  # fmt: skip
+    """One step of the wrapper's observation in one compiled call: :func:`sets_and_map` of the window
+    ``win`` of cells the step changed into the planes and ``base`` of ``maps`` (the clear / penumbra / dark
+    channels), then ``img[:3] = base``, ``img[3]`` the pose-box footprint (the pixels whose blocks meet the
+    cells of the position box ``pose_lo``, ``pose_hi``, :func:`~digslam.observer.core.grid_jit.window`)
+    and the 11 values of ``state`` (the wrapper's ``"state"``, with the heading interval ``heading``);
+    ``snap`` ``(3, ny, nx)`` uint8 receives copies of the explored codes, the clear mask and ``maps.free``.
+
+    ``steps`` is the number of elapsed steps and ``n_prev`` the certified count before the step; returns
+    the new count. No argument checks: the wrapper's own arrays (:class:`MapContext`). Only ``maps`` is a
+    named tuple: each one costs about a microsecond at every call from Python, and this call runs at every
+    step.
+    """
+    sure, free = maps.sure, maps.free
     ny, nx = sure.shape
-    explored, clear, dark, reach = planes[0], planes[1], planes[2], planes[3]
-    rs, re, cs, ce = blocks[0], blocks[1], blocks[2], blocks[3]
-    p0, p1 = _pixels(rs, r0, r1, ny)
-    q0, q1 = _pixels(cs, c0, c1, nx)
-    n = n_prev + _sets(sure, maybe, free, reach, explored, clear, dark, r0, r1, c0, c1)
-    _fill(clear, dark, base, 0, rs, re, cs, ce, p0, p1, q0, q1)
-    e8, c8, s8 = explored.reshape(-1), clear.reshape(-1), snap.reshape(-1)
+    planes = MapPlanes(maps.explored, maps.clear, maps.dark, maps.reach)
+    blocks = PixelBlocks(maps.row_start, maps.row_end, maps.col_start, maps.col_end)
+    base = maps.base
+    r0, r1, c0, c1 = win
+    p0, p1 = _pixels(blocks.row_start, r0, r1, ny)
+    q0, q1 = _pixels(blocks.col_start, c0, c1, nx)
+    n = n_prev + _sets(sure, maps.maybe, free, planes, win)
+    c8, d8 = planes.clear.view(np.uint8), planes.dark.view(np.uint8)
+    _fill(c8, d8, base, 0, blocks, (p0, p1, q0, q1))
+    e8, c8, s8 = planes.explored.view(np.uint8).reshape(-1), c8.reshape(-1), snap.reshape(-1)
     f8 = free.view(np.uint8).reshape(-1)
     k = e8.size
     for i in range(k):  # the snapshot: explored, clear, free
@@ -202,16 +268,19 @@ def _observe(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, planes: np.n
         o8[i] = b8[i]
     for i in range(k, k + k // 3):
         o8[i] = 0
-    x0, y0, x1, y1 = lo[0], lo[1], hi[0], hi[1]
-    f0, f1, g0, g1 = window(xs, nys, x0, y0, x1, y1)
-    p0, p1 = _pixels(rs, f0, f1, ny)
-    q0, q1 = _pixels(cs, g0, g1, nx)
+    x0, y0, x1, y1 = pose_lo[0], pose_lo[1], pose_hi[0], pose_hi[1]
+    f0, f1, g0, g1 = window(maps.xs, maps.nys, x0, y0, x1, y1)
+    p0, p1 = _pixels(blocks.row_start, f0, f1, ny)
+    q0, q1 = _pixels(blocks.col_start, g0, g1, nx)
     full = np.uint8(255)
     for p in range(p0, p1):
         row = img[3, p]
         for q in range(q0, q1):
             row[q] = full
-    cx, cy, hx, hy = norm[0], norm[1], norm[2], norm[3]
+    h0, h1 = heading
+    xs, nys = maps.xs, maps.nys
+    gx0, gx1, gy0, gy1 = xs[0], xs[xs.size - 1], -nys[nys.size - 1], -nys[0]  # the frame (exact)
+    cx, cy, hx, hy = 0.5 * (gx0 + gx1), 0.5 * (gy0 + gy1), 0.5 * (gx1 - gx0), 0.5 * (gy1 - gy0)
     hm, hw = 0.5 * (h0 + h1), 0.5 * (h1 - h0)
     state[0] = min(max((x0 - cx) / hx, -1.0), 1.0)
     state[1] = min(max((y0 - cy) / hy, -1.0), 1.0)
@@ -220,35 +289,29 @@ def _observe(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, planes: np.n
     state[4], state[5] = math.cos(hm), math.sin(hm)
     state[6] = min(hw / math.pi, 1.0)
     state[7] = math.tanh(max(x1 - x0, y1 - y0))
-    state[8] = min(steps / norm[4], 1.0)
-    state[9] = n / n_reach
+    state[8] = min(steps / maps.horizon, 1.0)
+    state[9] = n / maps.n_reach
     state[10] = 1.0
     return n
 
 
-def observe(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, planes: np.ndarray, base: np.ndarray,
-            img: np.ndarray, window: tuple[int, int, int, int], xs: np.ndarray, nys: np.ndarray,
-            lo: np.ndarray, hi: np.ndarray, heading: tuple[float, float], norm: np.ndarray, steps: int,
-            n_reach: int, n_prev: int, state: np.ndarray, snap: np.ndarray) -> int:  # fmt: skip
-    """One step of the wrapper's observation in one compiled call: :func:`sets_and_map` of ``window`` into
-    the sets and ``base`` (the clear / penumbra / dark channels), then ``img[:3] = base``, ``img[3]`` the
-    pose-box footprint (the pixels whose blocks meet the cells of the box ``lo, hi``,
-    :func:`.online_jit.window`) and the 11 values of ``state`` (the wrapper's ``"state"``).
-
-    ``planes`` is ``(4, ny, nx)`` uint8: the explored codes (int8 bytes), the clear and dark masks and the
-    reachable free cells (0 / 1); ``norm`` is ``(cx, cy, hx, hy, horizon)`` (grid centre and half-sides);
-    ``steps`` the elapsed steps, ``n_reach`` the reachable free cells and ``n_prev`` the certified count
-    before the step; ``snap`` ``(3, ny, nx)`` uint8 receives copies of the explored codes, the clear mask and
-    ``free``. Returns the new count. No argument checks: the wrapper's own arrays.
-    """
-    blocks = pixel_blocks(sure.shape, img.shape[-1])
-    return int(_observe(sure, maybe, free, planes, base, img, blocks, *window, xs, nys, lo, hi, heading[0],
-                        heading[1], norm, steps, n_reach, n_prev, state, snap))  # fmt: skip
+def map_context(sets: tuple[np.ndarray, np.ndarray, np.ndarray], planes: MapPlanes, base: np.ndarray,
+                xs: np.ndarray, nys: np.ndarray, horizon: float, n_reach: int) -> MapContext:  # fmt: skip
+    """The :class:`MapContext` of :func:`observe`: the filter's ``sets = (sure, maybe, free)``, the caller's
+    ``planes`` and ``base`` (kept), the pixel blocks of ``base.shape[-1]`` pixels a side, the grid's cell
+    bounds ``xs``, ``nys = -ys`` (its frame's ends first and last), the ``horizon`` and ``n_reach`` (the
+    reachable free cells, at least 1)."""
+    blocks = pixel_blocks(planes.clear.shape, base.shape[-1])
+    return MapContext(*sets, *planes, base, *blocks, xs, nys, float(horizon), int(n_reach))
 
 
-def pixel_blocks(shape: tuple[int, int], m: int) -> np.ndarray:
-    """``(4, m)`` int64: block bounds ``rs, re`` of the rows, ``cs, ce`` of the columns (:func:`_bounds`)."""
-    return np.array([*_bounds(shape[0], m)[:2], *_bounds(shape[1], m)[:2]], dtype=np.int64)
+@lru_cache(maxsize=64)
+def pixel_blocks(shape: tuple[int, int], m: int) -> PixelBlocks:
+    """The :class:`PixelBlocks` of a ``shape`` grid drawn on ``m x m`` pixels (:func:`_bounds`; cached, do not
+    write into it)."""
+    rs, re, _ = _bounds(shape[0], m)
+    cs, ce, _ = _bounds(shape[1], m)
+    return PixelBlocks(rs, re, cs, ce)
 
 
 def _check_sets(arrays: tuple[np.ndarray, ...]) -> None:
@@ -266,7 +329,8 @@ def observer_sets(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, reach: 
     clear cells inside ``reach``."""
     _check_sets((sure, maybe, free, reach, explored, clear, dark))
     clear[:] = False
-    return int(_sets(sure, maybe, free, reach, explored, clear, dark, 0, sure.shape[0], 0, sure.shape[1]))
+    planes = MapPlanes(explored, clear, dark, reach)
+    return int(_sets(sure, maybe, free, planes, (0, sure.shape[0], 0, sure.shape[1])))
 
 
 def sets_and_map(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, reach: np.ndarray,
@@ -275,15 +339,10 @@ def sets_and_map(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, reach: n
     """:func:`observer_sets` then :func:`fill_map` into ``img[0:3]``, restricted to the cells of ``window``
     ``(r0, r1, c0, c1)`` and the pixels whose blocks meet it (the rest is kept: the cells outside did not
     change); returns the change of the count. No argument checks: the wrapper's own arrays."""
-    ny, nx = sure.shape
-    m = img.shape[-1]
-    rs, re, _ = _bounds(ny, m)
-    cs, ce, _ = _bounds(nx, m)
+    planes = MapPlanes(explored, clear, dark, reach)
     r0, r1, c0, c1 = window
-    p0, p1 = pixel_range(r0, r1, ny, m)
-    q0, q1 = pixel_range(c0, c1, nx, m)
-    return int(_sets_and_map(sure, maybe, free, reach, explored, clear, dark, img, rs, re, cs, ce, r0, r1, c0,
-                             c1, p0, p1, q0, q1))  # fmt: skip
+    blocks = pixel_blocks(sure.shape, img.shape[-1])
+    return int(_sets_and_map(sure, maybe, free, planes, img, blocks, (int(r0), int(r1), int(c0), int(c1))))
 
 
 def pixel_range(r0: int, r1: int, n: int, m: int) -> tuple[int, int]:
@@ -309,10 +368,14 @@ def crop_window(mask: np.ndarray, r0: int, c0: int, k: int, fill: bool) -> np.nd
 
 
 __all__ = [
+    "MapContext",
+    "MapPlanes",
+    "PixelBlocks",
     "all_blocks",
     "block_starts",
     "crop_window",
     "fill_map",
+    "map_context",
     "observe",
     "observer_sets",
     "pixel_blocks",

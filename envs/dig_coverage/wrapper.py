@@ -5,7 +5,7 @@ into the
 pose box, the dig zone ``M⁻`` and the explored thick set, and the wrapper hands them to the agent:
 
 * ``"map"``: ``uint8 (C, m, m)`` channels-first image (SB3 image convention, values 0 / 255): clear,
-  penumbra, dark (conservative downsampling, :mod:`.observer_maps`), the pose-box footprint, and with
+  penumbra, dark (conservative downsampling, :mod:`.maps_jit`), the pose-box footprint, and with
   ``crop`` three more channels clear / penumbra / dark of a ``crop`` x ``crop`` m window centred on the pose
   box (world-aligned; outside the grid counts as dark);
 * ``"state"``: ``float32 (11,)``: the pose box ``(x⁻, y⁻, x⁺, y⁺)`` normalised to ``[-1, 1]`` over the grid
@@ -71,14 +71,20 @@ from gymnasium import spaces
 from scipy import ndimage
 
 from digslam.envs.dig_coverage.config import ObserverConfig
-from digslam.envs.dig_coverage.maps_jit import _observe, crop_window, fill_map, pixel_blocks
+from digslam.envs.dig_coverage.maps_jit import (
+    MapContext,
+    MapPlanes,
+    crop_window,
+    fill_map,
+    map_context,
+    observe,
+)
 from digslam.envs.dig_coverage.monitor import GuaranteeMonitor
 from digslam.envs.explore.coverage import Coverage
 from digslam.envs.sim.raster import FREE, rasterize
 from digslam.envs.sim.world import World
 from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam
 from digslam.observer.slam.grid import Grid
-from digslam.observer.slam.record import MissionRecord
 from digslam.observer.thick.sep import PENUMBRA
 
 N_STATE = 11
@@ -171,10 +177,6 @@ class GuaranteedObserver(gym.Wrapper):
         self._extra_info: dict[str, Any] = {}  # constant keys added to every info (subclasses)
         g = self.grid
         self.cell_area = g.cell_size[0] * g.cell_size[1]
-        self._centre = 0.5 * (np.array(g.lo) + np.array(g.hi))
-        self._half = 0.5 * (np.array(g.hi) - np.array(g.lo))
-        self._norm = np.array([*self._centre, *self._half, cfg.horizon], dtype=np.float64)  # for _observe
-        self._blocks = pixel_blocks(g.shape, cfg.map_size)
         self._obs: tuple[np.ndarray, np.ndarray] = (np.zeros(0, np.uint8), np.zeros(0, np.float32))
         self._reach_world: Any = None
         self.reachable = np.zeros(g.shape, dtype=bool)
@@ -186,6 +188,8 @@ class GuaranteedObserver(gym.Wrapper):
         self._planes = np.zeros((4, *shape), np.uint8)  # explored (int8), clear, dark, reachable: observe()
         self._explored_all, self._clear_all = self._planes[0].view(np.int8), self._planes[1].view(np.bool_)
         self._dark_all, self._base, self._n = self._planes[2].view(np.bool_), np.zeros((3, m, m), np.uint8), 0
+        self._xs, self._nys = np.array(g.xs, np.float64), np.array(-g.ys, np.float64)
+        self._maps: MapContext | None = None  # what :func:`.maps_jit.observe` reads and keeps: each reset
 
     # --- gymnasium API -------------------------------------------------------------------------------------
     def reset(self, **kwargs: Any) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
@@ -203,6 +207,10 @@ class GuaranteedObserver(gym.Wrapper):
         lo = np.maximum(p - b, np.array(self.grid.lo))
         hi = np.minimum(p + b, np.array(self.grid.hi))
         self.filter.reset(lo, hi, info["record"])
+        f = self.filter
+        sets = (f.sensed_sure, f.sensed_maybe, f.dig.free)
+        self._maps = map_context(sets, MapPlanes(*self._planes), self._base, self._xs, self._nys,
+                                 self.obs_config.horizon, self.n_reachable)  # fmt: skip
         self.steps, self._cache_step = 0, -1
         # ground truth over the cells of the certified coverage, the reachable free area (:mod:`.coverage`)
         self.truth_coverage = Coverage.on_cells(self.reachable[::-1], self.grid.lo, self.grid.cell_size,
@@ -218,7 +226,7 @@ class GuaranteedObserver(gym.Wrapper):
     def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         step = self.env._step(action, observe=False) if self._fast else self.env.step(action)
         _, reward, terminated, truncated, info = step
-        self.filter.update(info["record"])  # :meth:`_feed`, inlined
+        self.filter.update(info["record"])
         self.steps += 1
         if self.monitor is not None:
             self.monitor.check(self.filter, info["truth"], info["record"], self.steps)
@@ -236,11 +244,6 @@ class GuaranteedObserver(gym.Wrapper):
         """Raise ``ValueError`` if the grid does not cover ``world``'s frame."""
         make_grid(self.obs_config.replace(grid_frame=self.grid.lo + self.grid.hi), world.frame)
 
-    def _feed(self, rec: MissionRecord) -> None:
-        """Fold the env's record into the filter."""
-        self.filter.update(rec)
-        self.steps += 1
-
     def _check(self, info: dict[str, Any]) -> None:
         if self.monitor is not None:
             self.monitor.check(self.filter, info["truth"], info["record"], self.steps)
@@ -248,7 +251,7 @@ class GuaranteedObserver(gym.Wrapper):
     def _sets(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
         """The filter's explored codes, clear and dark masks and certified cell count, once per step, with
         the observation (:meth:`observation`): one compiled call (the kernel of
-        :func:`.observer_maps.observe`) keeps the sets and the map's clear / penumbra / dark channels up to
+        :func:`.maps_jit.observe`) keeps the sets and the map's clear / penumbra / dark channels up to
         date on the cells the step touched (:meth:`OnlineDigSlam.take_touched`) and draws the pose-box channel
         and the state; ``info`` gets copies of the sets."""
         if self._cache_step != self.steps:
@@ -259,11 +262,10 @@ class GuaranteedObserver(gym.Wrapper):
                 self._n = 0
             m = self.obs_config.map_size
             img, state = np.empty((self.n_channels, m, m), np.uint8), np.empty(N_STATE, dtype=np.float32)
-            d, snap = f.dig, np.empty((3, ny, nx), np.uint8)  # info's explored, clear and dig
-            self._n = int(_observe(f.sensed_sure, f.sensed_maybe, d.free, self._planes, self._base, img,
-                                   self._blocks, *win, d.xs, d.nys, f.pose_lo, f.pose_hi, f.heading_lo,
-                                   f.heading_hi, self._norm, self.steps, self.n_reachable, self._n, state,
-                                   snap))  # fmt: skip
+            snap = np.empty((3, ny, nx), np.uint8)  # info's explored, clear and dig
+            heading = (f.heading_lo, f.heading_hi)
+            self._n = int(observe(self._maps, f.pose_lo, f.pose_hi, heading, win, self.steps, self._n, img,
+                                  state, snap))  # fmt: skip
             if self.obs_config.crop is not None:
                 self._crop(img)
             self._obs = (img, state)

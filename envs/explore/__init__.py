@@ -13,6 +13,8 @@ from .coverage import (
 )
 from .coverage_jit import (
     NB,
+    ConeReach,
+    CoverGrid,
     cover_kernel,
     cover_update,
     pseudo_angle,
@@ -30,6 +32,8 @@ from .truth import (
 )
 
 __all__ = [
+    "ConeReach",
+    "CoverGrid",
     "Coverage",
     "Episode",
     "ExploreEnv",

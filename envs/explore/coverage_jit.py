@@ -9,24 +9,27 @@ not yet seen cell of the window whose centre lies strictly closer than the radiu
 smallest radius are marked first; then each interval of a larger radius scans the bounding box of its
 sector only, and decides each cell there through a lookup table of pseudo-angle bins (a binary search in
 the bins that hold a bound), keeping the cells whose interval it is. Same decisions as the numpy version it
-replaced (the test oracle of ``tests/test_sim_jit.py``), except for cell centres within rounding of a cone
+replaced (the test oracle of ``tests/envs/sim/test_kernels.py``), except for cell centres within rounding of
+a cone
 edge.
 
 Example (one omnidirectional sensor of reach 0.12 at the centre of a 3 x 3 grid of 0.1 m cells):
     >>> import numpy as np
     >>> free, seen = np.ones((3, 3), dtype=bool), np.zeros((3, 3), dtype=bool)
     >>> xs = ys = np.array([0.05, 0.15, 0.25])
-    >>> cover_kernel(free, seen, xs, ys, 0, 3, 0, 3, 0.15, 0.15, 0.0, np.array([0.0]),
-    ...              np.ones((1, 1), dtype=bool), np.array([np.inf]), np.array([0.12]))
+    >>> cones = ConeReach(np.array([0.0]), np.ones((1, 1), dtype=bool), np.array([np.inf]), np.array([0.12]))
+    >>> cover_kernel(CoverGrid(free, seen, xs, ys), 0, 3, 0, 3, 0.15, 0.15, 0.0, cones)
     5
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
+from digslam.observer.core.angles_jit import axes_in
 from digslam.observer.core.scalar_jit import njit
 
 #: Bins of the per-step radius lookup table over pseudo-angles ``[0, 4)``.
@@ -44,22 +47,62 @@ def pseudo_angle(x: float, y: float) -> float:
     return 2.0 - y / (-x - y) if x < 0.0 else 3.0 + x / (x - y)
 
 
-@njit
-def cover_kernel(free: np.ndarray, seen: np.ndarray, xs: np.ndarray, ys: np.ndarray, i0: int, i1: int,
-                 j0: int, j1: int, x: float, y: float, th: float, breaks: np.ndarray, cover: np.ndarray,
-                 ranges: np.ndarray, r_max: np.ndarray) -> int:  # fmt: skip
-    """Mark the cells ``[i0:i1, j0:j1]`` sensed from ``(x, y, th)`` in ``seen``; return how many are new.
+class CoverGrid(NamedTuple):
+    """The raster :func:`cover_kernel` marks.
 
-    Args:
+    Attributes:
         free, seen: Boolean rasters ``(ny, nx)``; ``seen`` is updated in place.
-        xs, ys: Cell-centre coordinates.
-        i0, i1, j0, j1: The window of rows and columns.
-        x, y, th: Sensor pose.
+        xs, ys: Cell-centre coordinates ``(nx,)``, ``(ny,)``, increasing.
+    """
+
+    free: np.ndarray
+    seen: np.ndarray
+    xs: np.ndarray
+    ys: np.ndarray
+
+
+class ConeReach(NamedTuple):
+    """How far the sensors see on each angular interval between cone edges (robot frame).
+
+    Attributes:
         breaks: Cone-edge bearings in the robot frame, in ``[0, 2 pi)``, sorted, starting at 0, ``(B,)``.
         cover: ``(B, n)``: which sensors cover the interval that starts at each break.
         ranges: True range per sensor ``(n,)`` (``inf`` without echo).
         r_max: Maximum ranges ``(n,)``; a sensor senses up to ``min(range, r_max)``.
     """
+
+    breaks: np.ndarray
+    cover: np.ndarray
+    ranges: np.ndarray
+    r_max: np.ndarray
+
+
+class _Scan(NamedTuple):
+    """What :func:`_scan` reads: the raster, the window of rows ``i0:i1`` and columns ``j0:j1``, the sensor
+    position, the cell sides (``inf`` for a single row or column) and the bearing intervals (their starts
+    ``ws`` in pseudo-angle order and the lookup table ``tab`` over ``NB`` bins)."""
+
+    grid: CoverGrid
+    i0: int
+    i1: int
+    j0: int
+    j1: int
+    x: float
+    y: float
+    resx: float
+    resy: float
+    ws: np.ndarray
+    tab: np.ndarray
+
+
+@njit
+def cover_kernel(grid: CoverGrid, i0: int, i1: int, j0: int, j1: int, x: float, y: float, th: float,
+                 cones: ConeReach) -> int:  # fmt: skip
+    """Mark the cells ``[i0:i1, j0:j1]`` of ``grid`` sensed from ``(x, y, th)`` in ``grid.seen``; return
+    how many are new. ``cones``: the sensed radius per bearing interval (:class:`ConeReach`).
+    """
+    breaks, cover, ranges, r_max = cones.breaks, cones.cover, cones.ranges, cones.r_max
+    xs, ys = grid.xs, grid.ys
     B, n = cover.shape
     two_pi = 2 * np.pi
     world, rad, wrad = np.empty(B), np.zeros(B), np.empty(B)
@@ -95,10 +138,10 @@ def cover_kernel(free: np.ndarray, seen: np.ndarray, xs: np.ndarray, ys: np.ndar
         c_lo = c
     resx = (xs[xs.shape[0] - 1] - xs[0]) / (xs.shape[0] - 1) if xs.shape[0] > 1 else math.inf  # one column:
     resy = (ys[ys.shape[0] - 1] - ys[0]) / (ys.shape[0] - 1) if ys.shape[0] > 1 else math.inf  # no cut needed
-    w = (free, seen, xs, ys, i0, i1, j0, j1, x, y, resx, resy)
+    w = _Scan(grid, i0, i1, j0, j1, x, y, resx, resy, ws, tab)
     # Cells nearer than the smallest radius are sensed whatever their bearing.
     rm = math.sqrt(r2min)
-    count = _scan(w, -rm, rm, -rm, rm, r2min, -1, r2min, ws, tab, B)
+    count = _scan(w, -rm, rm, -rm, rm, r2min, -1, r2min)
     # Then each interval of a larger radius, over the bounding box of its sector (cells of other intervals
     # in the box are left to their own interval).
     for b in range(B):
@@ -108,32 +151,31 @@ def cover_kernel(free: np.ndarray, seen: np.ndarray, xs: np.ndarray, ys: np.ndar
         a0, a1 = wr[b], (wr[b + 1] if b + 1 < B else wr[0] + two_pi)
         xlo, xhi = min(0.0, R * math.cos(a0), R * math.cos(a1)), max(0.0, R * math.cos(a0), R * math.cos(a1))
         ylo, yhi = min(0.0, R * math.sin(a0), R * math.sin(a1)), max(0.0, R * math.sin(a0), R * math.sin(a1))
-        for q in range(9):  # the axis directions q pi / 2 inside the sector
-            if a0 - 1e-9 <= q * (0.5 * np.pi) <= a1 + 1e-9:
-                m = q % 4
-                if m == 0:
-                    xhi = max(xhi, R)
-                elif m == 1:
-                    yhi = max(yhi, R)
-                elif m == 2:
-                    xlo = min(xlo, -R)
-                else:
-                    ylo = min(ylo, -R)
-        count += _scan(w, xlo, xhi, ylo, yhi, r2[b], b, r2min, ws, tab, B)
+        east, north, west, south = axes_in(a0, a1)  # the axis directions inside the sector
+        if east:
+            xhi = max(xhi, R)
+        if north:
+            yhi = max(yhi, R)
+        if west:
+            xlo = min(xlo, -R)
+        if south:
+            ylo = min(ylo, -R)
+        count += _scan(w, xlo, xhi, ylo, yhi, r2[b], b, r2min)
     return count
 
 
 @njit
-def _scan(w: tuple, xlo: float, xhi: float, ylo: float, yhi: float, r2b: float, b: int, r2min: float,
-          ws: np.ndarray, tab: np.ndarray, B: int) -> int:  # fmt: skip
+def _scan(w: _Scan, xlo: float, xhi: float, ylo: float, yhi: float, r2b: float, b: int, r2min: float) -> int:
     """Mark the free, unseen cells of the box ``[xlo, xhi] x [ylo, yhi]`` (relative to the pose, widened by
     two cells) closer than ``sqrt(r2b)``: all of them if ``b < 0``, else those of bearing interval ``b``
     beyond ``sqrt(r2min)``."""
-    free, seen, xs, ys, i0, i1, j0, j1, x, y, resx, resy = w
-    ia = max(i0, int(math.floor((y + ylo - ys[0]) / resy)) - 2)
-    ib = min(i1, int(math.floor((y + yhi - ys[0]) / resy)) + 3)
-    ja = max(j0, int(math.floor((x + xlo - xs[0]) / resx)) - 2)
-    jb = min(j1, int(math.floor((x + xhi - xs[0]) / resx)) + 3)
+    free, seen, xs, ys = w.grid.free, w.grid.seen, w.grid.xs, w.grid.ys
+    x, y, resx, resy, ws, tab = w.x, w.y, w.resx, w.resy, w.ws, w.tab
+    B = ws.size
+    ia = max(w.i0, int(math.floor((y + ylo - ys[0]) / resy)) - 2)
+    ib = min(w.i1, int(math.floor((y + yhi - ys[0]) / resy)) + 3)
+    ja = max(w.j0, int(math.floor((x + xlo - xs[0]) / resx)) - 2)
+    jb = min(w.j1, int(math.floor((x + xhi - xs[0]) / resx)) + 3)
     count = 0
     for i in range(ia, ib):
         vy = ys[i] - y
@@ -149,15 +191,10 @@ def _scan(w: tuple, xlo: float, xhi: float, ylo: float, yhi: float, r2b: float, 
                     continue
                 p = pseudo_angle(vx, vy)
                 k = tab[min(int(p * 64.0), NB - 1)]
-                if k == -2:  # binary search: k = #(ws <= p) - 1
-                    lo, hi = 0, B
-                    while lo < hi:
-                        mid = (lo + hi) // 2
-                        if ws[mid] <= p:
-                            lo = mid + 1
-                        else:
-                            hi = mid
-                    k = lo - 1 if lo > 0 else B - 1  # before the first bound: the last interval
+                if k == -2:  # k = #(ws <= p) - 1 (np.searchsorted side="right" counts the ws <= p)
+                    k = np.searchsorted(ws, p, side="right") - 1
+                    if k < 0:  # before the first bound: the last interval
+                        k = B - 1
                 if k != b:
                     continue
             seen[i, j] = True
@@ -183,11 +220,14 @@ def cover_update(free: np.ndarray, seen: np.ndarray, xs: np.ndarray, ys: np.ndar
     ky = min(int(win[5]), int(math.ceil(far / win[3])) + 1)
     ic, jc = int(math.floor((y - win[1]) / win[3])), int(math.floor((x - win[0]) / win[2]))
     i0, i1, j0, j1 = max(ic - ky, 0), min(ic + ky + 1, ny), max(jc - kx, 0), min(jc + kx + 1, nx)
-    return cover_kernel(free, seen, xs, ys, i0, i1, j0, j1, x, y, th, breaks, cover, ranges, r_max)
+    return cover_kernel(CoverGrid(free, seen, xs, ys), i0, i1, j0, j1, x, y, th,
+                        ConeReach(breaks, cover, ranges, r_max))  # fmt: skip
 
 
 __all__ = [
     "NB",
+    "ConeReach",
+    "CoverGrid",
     "cover_kernel",
     "cover_update",
     "pseudo_angle",

@@ -1,9 +1,10 @@
 """``digslam/Explore-v0``: a disc robot with exact sonar cones exploring an unknown world.
 
-Action: normalised ``(v, omega)`` in ``[-1, 1]^2``. Observation (dict): range intervals ``ranges (n, 2)``
-(``[r_max, top]`` where no echo), ``no_echo (n,)``, ``odometry (2, 2)`` (speed and yaw-rate intervals over
-the step just ended) and ``heading (2,)`` (compass interval, shifted by a multiple of 2 pi into about
-``[-pi, pi]``). Reward: the newly and truly sensed free area (m^2). ``info`` holds the
+Action: normalised ``(v, omega)`` in ``[-1, 1]^2``: the commanded body-frame speed and yaw rate. Observation
+(dict): range intervals ``ranges (n, 2)`` (``[r_max, top]`` where no echo), ``no_echo (n,)``,
+``odometry (3, 2)`` (intervals of the forward speed, the leftward velocity and the yaw rate over the step
+just ended) and ``heading (2,)`` (compass interval, shifted by a multiple of 2 pi into about ``[-pi, pi]``).
+Reward: the newly and truly sensed free area (m^2). ``info`` holds the
 :class:`~digslam.observer.slam.record.MissionRecord` under ``"record"`` and the
 :class:`~digslam.envs.explore.episode.GroundTruth` under ``"truth"``.
 
@@ -11,16 +12,22 @@ Record convention (record ``j`` is the one returned at time ``t_j``; ``j = 0`` b
 
 * ``heading[j]`` bounds the true heading at ``t_j`` and ``range[j]`` the exact distances from the pose at
   ``t_j``;
-* ``speed[j]`` and ``yaw_rate[j]`` bound the true values over the WHOLE step that just ended,
-  ``[t_{j-1}, t_j]`` (the hull over all its physics substeps, see :mod:`.robot`), not instantaneous values;
-  record 0 carries the robot at rest, ``[0, 0]`` widened by the noise bound.
+* ``speed[j]``, ``lateral[j]`` and ``yaw_rate[j]`` bound the true body-frame velocity ``(v_1, v_2)`` and yaw
+  rate over the WHOLE step that just ended, ``[t_{j-1}, t_j]`` (the hull over all its physics substeps, see
+  :mod:`digslam.envs.sim.robot`), not instantaneous values; record 0 carries the robot at rest, ``[0, 0]``
+  widened by the noise bound. The unicycle cannot slip: its ``lateral`` is ``[0, 0]``, exactly.
 
 This is the data contract of :mod:`digslam.observer.slam.record`, which the observers (offline ``dig_slam``,
 the online filter of :mod:`.observer_wrapper`) read as it is. Every bound contains the exact truth,
-floating point included: the truth is the chain of exact arcs of :mod:`.arc` (the stored heading is exact,
-the stored position within the proved ``truth.pose_error``), the odometry hulls are the pieces' exact speeds
-and outward-rounded yaw rates, and the ranges are rigorous bounds around the true pose
-(:meth:`~.sensors.SensorSuite.range_bounds`). Each step lasts exactly the time between its two records.
+floating point included. Under pymunk dynamics (``dynamics="pymunk"``, the default) the truth is the
+piecewise-linear path through the substep states pymunk produced (``truth.states``, ``truth.taus``; exact
+by definition, ``pose_error = 0``) and the odometry hulls are rigorous bounds of its body-frame velocity and
+yaw rate (:mod:`digslam.envs.sim.dynamics_jit`); under the unicycle it is the chain of exact arcs of
+:mod:`digslam.envs.sim.arc_jit` (``truth.pieces``; the stored heading is exact, the stored position within
+the proved ``truth.pose_error``), and the odometry hulls are the pieces' exact speeds and outward-rounded
+yaw rates. Either way the robot's disc never overlaps an obstacle, and the ranges are rigorous bounds around
+the true pose (:meth:`~digslam.envs.sim.sensors.SensorSuite.range_bounds`). Each step lasts exactly the time
+between its two records.
 """
 
 from __future__ import annotations
@@ -83,9 +90,8 @@ class ExploreEnv(gym.Env):
         self.generator = _generator(cfg)
         n, nz = self.suite.n, cfg.noise
         self._top = float(self.suite.r_max.max() + 2 * nz.range + 1.0)
-        self._odo_top = np.array(
-            [[10 * cfg.max_speed + 2 * nz.speed + 1.0], [10 * cfg.max_yaw_rate + 2 * nz.yaw_rate + 1.0]]
-        )
+        s_top = 10 * cfg.max_speed + 2 * nz.speed + 1.0
+        self._odo_top = np.array([[s_top], [s_top], [10 * cfg.max_yaw_rate + 2 * nz.yaw_rate + 1.0]])
         self.action_space = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
         self.observation_space = spaces.Dict(
             {
@@ -102,7 +108,7 @@ class ExploreEnv(gym.Env):
                 ),
             }
         )
-        self._odo_tops = (float(self._odo_top[0, 0]), float(self._odo_top[1, 0]))
+        self._odo_tops = (float(self._odo_top[0, 0]), float(self._odo_top[2, 0]))
         hb = self.observation_space["heading"]
         self._heading_box = (float(hb.low[0]), float(hb.high[0]))
         self.world: World | None = None
@@ -130,7 +136,9 @@ class ExploreEnv(gym.Env):
             pose = np.array([0.0, 0.0, heading])
         else:
             pose = self.world.sample_free_pose(self.np_random, 1.5 * cfg.robot_radius + skin)
-        self.sim = RobotSim(self.world, cfg.robot_radius, pose, cfg.max_force, cfg.max_torque, skin)
+        self.sim = RobotSim(
+            self.world, cfg.robot_radius, pose, cfg.max_force, cfg.max_torque, skin, cfg.dynamics
+        )
         self.coverage = Coverage(self.world, cfg.coverage_resolution, float(self.suite.r_max.max()))
         self.t, self.path = 0.0, [pose[:2].copy()]
         record, truth = self._sense(0)
@@ -207,10 +215,18 @@ class ExploreEnv(gym.Env):
         pose = sim.pose
         ranges = self.suite.true_ranges(self.world, pose)
         bounds = self.suite.range_bounds(self.world, pose, sim.pose_error)
+        pymunk = sim.dynamics == "pymunk"
         record = measure_step(self.t, self.suite, bounds, sim.speed_hull, sim.yaw_hull, pose[2],
-                              self.config.noise, self.np_random)  # fmt: skip
+                              self.config.noise, self.np_random,
+                              lateral=sim.lateral_hull if pymunk else None)  # fmt: skip
+        states = taus = None
+        if pymunk:
+            states, taus = sim.states, sim.taus  # fresh arrays each step (the durations shared, read-only)
+            if not len(taus):  # at reset: at rest, S + 1 copies of the start pose
+                n = self.config.substeps
+                states, taus = np.repeat(pose[None], n + 1, axis=0), np.zeros(n)
         truth = GroundTruth.of_step(self.t, pose, sim.speed, sim.yaw_rate, ranges, bumps, sim.bumps,
-                                    sim.pieces.copy(), sim.pose_error)  # fmt: skip
+                                    sim.pieces.copy(), sim.pose_error, sim.lateral, states, taus)  # fmt: skip
         return record, truth
 
     def _reward(self, truth: GroundTruth) -> float:
@@ -233,7 +249,7 @@ class ExploreEnv(gym.Env):
     def _obs(self, record: MissionRecord) -> dict[str, np.ndarray]:
         # lower range bounds are >= 0 by construction; the heading is shifted by a multiple of 2 pi
         lo, hi = self._heading_box
-        ranges, no_echo, odo, heading = obs_kernel(record.range, record.no_echo, record.speed,
+        ranges, no_echo, odo, heading = obs_kernel(record.range, record.no_echo, record.speed, record.lateral,
                                                    record.yaw_rate, record.heading, self._top,
                                                    self._odo_tops[0], self._odo_tops[1], lo, hi)  # fmt: skip
         return {"ranges": ranges, "no_echo": no_echo, "odometry": odo, "heading": heading}

@@ -41,10 +41,12 @@ class Episode:
 
     @staticmethod
     def load(path: str | Path) -> Episode:
-        """Load an episode saved by :meth:`save`."""
+        """Load an episode saved by :meth:`save` (one saved before a field existed gets its old meaning:
+        unicycle dynamics, no lateral velocity, no substep path)."""
         with np.load(path) as z:
             data = dict(z)
         cfg: dict[str, Any] = json.loads(str(data["config"]))
+        cfg.setdefault("dynamics", "unicycle")  # saved before pymunk dynamics: every robot was a unicycle
         if cfg.get("start") is not None:
             cfg["start"] = tuple(cfg["start"])
         truth = GroundTruth(**{f.name: data.get("truth_" + f.name) for f in fields(GroundTruth)})

@@ -4,9 +4,11 @@ Lives here, in data-flow order: :mod:`.world` (``World``: polygonal obstacles an
 (marching squares), :mod:`.raster`, :mod:`.generators` (``ThesisRoom``, ``RockField``, ``Caves``,
 ``RoomsCorridors``, ``FileMap``), :mod:`.geometry` and :mod:`.geometry_jit` (rigorous point-edge and sector
 distances), :mod:`.arc_jit` (the exact arc of one piece of motion and its proved error bound),
-:mod:`.robot` and :mod:`.robot_jit` (``RobotSim``), :mod:`.sensors` (``SensorSuite``: sonars,
-omnidirectional range, odometry, compass), :mod:`.noise` and :mod:`.noise_jit` (bounded noise, outliers),
-:mod:`.missions` (the thesis's missions as records) and :mod:`.render` (pictures).
+:mod:`.robot` and :mod:`.robot_jit` (``RobotSim``: pymunk dynamics or exact unicycle arcs),
+:mod:`.dynamics_jit` (the pymunk robot's premise guard, substep durations and velocity bounds),
+:mod:`.sensors` (``SensorSuite``: sonars, omnidirectional range, odometry, compass), :mod:`.noise` and
+:mod:`.noise_jit` (bounded noise, outliers), :mod:`.missions` (the thesis's missions as records) and
+:mod:`.render` (pictures).
 
 May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.slam.record`, :mod:`digslam.envs.config`;
 numpy, scipy, pymunk, pygame (on use). No gymnasium.
@@ -19,6 +21,11 @@ from .arc_jit import (
     arc_move,
     exact_duration,
     yaw_rate_bounds,
+)
+from .dynamics_jit import (
+    step_bounds,
+    substep_clear,
+    substep_times,
 )
 from .generators import (
     GENERATORS,
@@ -40,9 +47,11 @@ from .geometry import (
 )
 from .geometry_jit import (
     edge_boxes,
+    edge_near,
     points_edges_kernel,
     sector_bounds_kernel,
     sector_kernel,
+    segment_distance,
 )
 from .missions import (
     THESIS_LOOP,
@@ -54,6 +63,8 @@ from .noise import (
 )
 from .noise_jit import (
     MODEL_CODES,
+    RecordModel,
+    StepTruth,
     noise_kernel,
     obs_kernel,
     record_kernel,
@@ -70,8 +81,10 @@ from .render import (
 )
 from .robot import (
     FRACTIONS,
+    ROBOT_FRICTION,
     ROBOT_TYPE,
     SWEEP_POINTS,
+    WALL_FRICTION,
     WALL_TYPE,
     RobotSim,
 )
@@ -104,15 +117,19 @@ __all__ = [
     "MIXED",
     "MODEL_CODES",
     "ROBOT_TYPE",
+    "ROBOT_FRICTION",
+    "RecordModel",
     "Renderer",
     "RobotSim",
     "RockField",
     "RoomsCorridors",
     "SWEEP_POINTS",
     "SensorSuite",
+    "StepTruth",
     "THESIS_LOOP",
     "THESIS_ROOM",
     "ThesisRoom",
+    "WALL_FRICTION",
     "WALL_TYPE",
     "World",
     "WorldGenerator",
@@ -124,6 +141,7 @@ __all__ = [
     "chain_rings",
     "edge_bboxes",
     "edge_boxes",
+    "edge_near",
     "exact_duration",
     "grid_shape",
     "loop_mission",
@@ -144,6 +162,10 @@ __all__ = [
     "sector_bounds_kernel",
     "sector_distance",
     "sector_kernel",
+    "segment_distance",
     "smooth_noise",
+    "step_bounds",
+    "substep_clear",
+    "substep_times",
     "yaw_rate_bounds",
 ]

@@ -33,7 +33,7 @@ truth, the result is within ``E₀ + E``: the heading is exact, so position erro
 through the direction. The simulator carries this running sum (``pose_error``) over the whole episode: a
 bound of the accumulated state, whatever the actions (``ω = 0``, subnormal, the largest yaw rate, long
 episodes with an unwrapped heading: ``|θ₀|`` enters ``e_m`` linearly). ``E`` is evaluated with upward
-rounding and doubled, so the bound is itself rigorous. ``tests/test_sim_arc.py`` checks it against a
+rounding and doubled, so the bound is itself rigorous. ``tests/envs/sim/test_arc.py`` checks it against a
 200-bit reference, with hypothesis over tiny, huge, subnormal and sign-alternating yaw rates.
 
 Example (a tiny yaw rate: the chord form keeps full accuracy):

@@ -10,7 +10,7 @@ the nearest obstacle point in the sector whenever the apex is free. It is exact 
 minimum of the convex distance function over the edge's part inside the sector is reached at the foot of
 the perpendicular, at an endpoint inside the sector, or where the edge crosses a boundary ray. The distance
 routines run compiled (:mod:`.geometry_jit`); the numpy versions they replaced are the test oracles of
-``tests/test_sim_jit.py``.
+``tests/envs/sim/test_kernels.py``.
 """
 
 from __future__ import annotations
@@ -54,7 +54,7 @@ def point_edge_distance(points: np.ndarray, edges: Edges) -> np.ndarray:
     """Distance from each point to the nearest edge, shape ``(N,)`` (``inf`` with no edges).
 
     Compiled (:func:`.geometry_jit.points_edges_kernel`); the numpy version it replaced is the test oracle
-    of ``tests/test_sim_jit.py``.
+    of ``tests/envs/sim/test_kernels.py``.
     """
     pts = np.ascontiguousarray(np.atleast_2d(np.asarray(points, dtype=np.float64)))
     e = np.ascontiguousarray(edges, dtype=np.float64).reshape(-1, 4)

@@ -5,7 +5,7 @@ with the
 bounding-box pre-filter fused in (an edge whose box lies farther than
 ``reach`` from the point is skipped; ``reach = inf`` keeps every edge). :func:`sector_kernel` and
 :func:`points_edges_kernel` compute float64 values, with the same formulas as the numpy code they replace
-(kept as test oracles in ``tests/test_sim_jit.py``):
+(kept as test oracles in ``tests/envs/sim/test_kernels.py``):
 
 * :func:`sector_kernel` -- the sonar distance of thesis Eq. (4.22), ``d = inf {d | f(S_1, d) ∩ not M ≠ ∅}``:
   the nearest edge point inside each circular sector (exact, no ray fan): per edge,
@@ -19,7 +19,8 @@ bounding-box pre-filter fused in (an edge whose box lies farther than
   the simulator's proved pose error, floating point included): the record's range intervals are built on
   them, while :func:`sector_kernel` gives the float value the rewards and the rendering use.
 
-The robot's swept-disc checks (:mod:`.robot_jit`) reuse the scalar helpers.
+The robot's swept-disc checks (:mod:`.robot_jit`) reuse the scalar helpers :func:`edge_near` and
+:func:`segment_distance`.
 
 Example (a cone facing a wall 2 m away, and one facing away from it):
     >>> import numpy as np
@@ -34,6 +35,7 @@ Example (a cone facing a wall 2 m away, and one facing away from it):
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -60,16 +62,18 @@ def edge_boxes(edges: np.ndarray) -> np.ndarray:
 
 
 @njit(inline="always")
-def _near(bbox: np.ndarray, k: int, x: float, y: float, reach2: float) -> bool:
-    """Whether edge ``k``'s box comes within ``sqrt(reach2)`` of ``(x, y)``."""
+def edge_near(bbox: np.ndarray, k: int, x: float, y: float, reach2: float) -> bool:
+    """Whether the bounding box ``bbox[k]`` (:func:`edge_boxes`) of edge ``k`` comes within ``sqrt(reach2)``
+    of ``(x, y)`` (the pre-filter of the edge loops; ``reach2 = inf`` keeps every edge)."""
     dx = max(max(bbox[k, 0] - x, x - bbox[k, 2]), 0.0)
     dy = max(max(bbox[k, 1] - y, y - bbox[k, 3]), 0.0)
     return dx * dx + dy * dy <= reach2
 
 
 @njit(inline="always")
-def _seg_dist(ax: float, ay: float, dx: float, dy: float) -> float:
-    """Distance from the origin to the segment ``a + t d``, ``t in [0, 1]`` (clamped foot)."""
+def segment_distance(ax: float, ay: float, dx: float, dy: float) -> float:
+    """Distance (float64, not rounded outward) from the origin to the segment ``a + t d``, ``t in [0, 1]``:
+    the distance to the foot of the perpendicular, clamped to the segment."""
     dd = dx * dx + dy * dy
     t = 0.0
     if dd > 0.0:
@@ -101,7 +105,7 @@ def sector_kernel(x: float, y: float, th: float, alpha: np.ndarray, gamma: np.nd
     reach2 = reach * reach
     px, py, nrm = np.empty(3), np.empty(3), np.empty(3)
     for k in range(E):
-        if not _near(bbox, k, x, y, reach2):
+        if not edge_near(bbox, k, x, y, reach2):
             continue
         ax, ay = edges[k, 0] - x, edges[k, 1] - y
         dx, dy = edges[k, 2] - edges[k, 0], edges[k, 3] - edges[k, 1]
@@ -146,9 +150,9 @@ def sector_kernel(x: float, y: float, th: float, alpha: np.ndarray, gamma: np.nd
 def _min_dist(x: float, y: float, edges: np.ndarray, bbox: np.ndarray, reach2: float) -> float:
     best = _INF
     for k in range(edges.shape[0]):
-        if _near(bbox, k, x, y, reach2):
+        if edge_near(bbox, k, x, y, reach2):
             ax, ay = edges[k, 0] - x, edges[k, 1] - y
-            best = min(best, _seg_dist(ax, ay, edges[k, 2] - edges[k, 0], edges[k, 3] - edges[k, 1]))
+            best = min(best, segment_distance(ax, ay, edges[k, 2] - edges[k, 0], edges[k, 3] - edges[k, 1]))
     return best
 
 
@@ -167,30 +171,62 @@ _ETA = 5e-324
 _LU = LIBM_ULPS * 2.0 * _U  # libm error on a value in [-1, 1]
 
 
+class _Edge(NamedTuple):
+    """One edge relative to the sensor position ``p`` (see :func:`_edge_cone`): ``a = (ax, ay)``,
+    ``d = (dx, dy)``, the number ``npts`` of its candidate nearest points (endpoints, foot), ``seg`` a lower
+    bound of the whole edge's distance and ``e_pt`` the candidates' position error."""
+
+    ax: float
+    ay: float
+    dx: float
+    dy: float
+    npts: int
+    seg: float
+    e_pt: float
+
+
+class _ConeBounds(NamedTuple):
+    """One cone as :func:`_edge_cone` reads it: the direction ``(ux, uy)`` within ``e_u`` per component,
+    ``cos γ = cg`` within ``_LU``, the boundary rays ``w0``, ``w1`` within ``e_w0``, ``e_w1``, the apex
+    shift ``sh`` and ``whole`` (the whole plane, ``γ = π``)."""
+
+    ux: float
+    uy: float
+    cg: float
+    w0x: float
+    w0y: float
+    w1x: float
+    w1y: float
+    e_u: float
+    e_w0: float
+    e_w1: float
+    sh: float
+    whole: bool
+
+
 @njit(inline="always")
-def _edge_cone(ax: float, ay: float, dx: float, dy: float, px: np.ndarray, py: np.ndarray, pn: np.ndarray,
-               pe: np.ndarray, npts: int, seg: float, e_pt: float, ux: float, uy: float, cg: float,
-               w0x: float, w0y: float, w1x: float, w1y: float, e_u: float, e_w0: float, e_w1: float,
-               sh: float, whole: bool) -> tuple[float, float]:  # fmt: skip
+def _edge_cone(edge: _Edge, px: np.ndarray, py: np.ndarray, pn: np.ndarray, pe: np.ndarray, cone: _ConeBounds
+               ) -> tuple[float, float]:  # fmt: skip
     """Bounds ``(lower, upper)`` on the distance from the apexes ``p ∓ sh u`` to the nearest point of one
     edge inside the exact cone of that apex; see :func:`sector_bounds_kernel`.
 
-    The edge is given relative to ``p``: ``a = (ax, ay)``, ``d = (dx, dy)``, its candidate points
-    ``(px, py)`` (endpoints, foot) with computed norms ``pn`` within ``pe`` of the exact distances of exact
-    edge points, ``seg`` a lower bound of the whole edge's distance, ``e_pt`` the points' position error.
-    The cone's direction ``(ux, uy)`` is within ``e_u`` per component, ``cos γ = cg`` within ``_LU``, the
-    boundary rays ``w0``, ``w1`` within ``e_w0``, ``e_w1``. The lower bound is for the backward apex
-    ``p − sh u`` and keeps every candidate that may lie in its cone (``inf`` when none can); the upper bound
-    is for the forward apex ``p + sh u`` and keeps only candidates proved inside its cone (``inf`` if none
-    is). Moving the apex by ``sh`` moves each distance by at most ``sh`` and ``u·q − |q| cos γ`` by at most
-    ``sh (1 + |cos γ|) ≤ 2 sh``, and the foot of the shifted apex lies within ``sh`` of ``p``'s (projection
-    onto a segment is 1-Lipschitz; ``u·q − |q| cos γ`` is 2-Lipschitz in ``q``), hence the ``4 sh`` in the
-    membership margin; the crossings are recomputed for each apex (they are linear in it).
+    ``edge`` is the edge relative to ``p`` (:class:`_Edge`) and ``(px[j], py[j])`` its candidates
+    (``j < edge.npts``), whose computed norms ``pn`` are within ``pe`` of the exact distances of exact edge
+    points; ``cone`` the cone with the error bounds of its direction and boundary rays
+    (:class:`_ConeBounds`). The lower bound is for the backward apex ``p − sh u`` and keeps every candidate
+    that may lie in its cone (``inf`` when none can); the upper bound is for the forward apex ``p + sh u``
+    and keeps only candidates proved inside its cone (``inf`` if none is). Moving the apex by ``sh`` moves
+    each distance by at most ``sh`` and ``u·q − |q| cos γ`` by at most ``sh (1 + |cos γ|) ≤ 2 sh``, and the
+    foot of the shifted apex lies within ``sh`` of ``p``'s (projection onto a segment is 1-Lipschitz;
+    ``u·q − |q| cos γ`` is 2-Lipschitz in ``q``), hence the ``4 sh`` in the membership margin; the
+    crossings are recomputed for each apex (they are linear in it).
     """
+    ax, ay, dx, dy, e_pt = edge.ax, edge.ay, edge.dx, edge.dy, edge.e_pt
+    ux, uy, cg, e_u, sh = cone.ux, cone.uy, cone.cg, cone.e_u, cone.sh
     lo, hi = math.inf, math.inf
-    for j in range(npts):
+    for j in range(edge.npts):
         n, e_n = pn[j], pe[j]
-        if whole:
+        if cone.whole:
             lo, hi = min(lo, n - e_n), min(hi, n + e_n)
             continue
         g = ux * px[j] + uy * py[j] - n * cg
@@ -199,14 +235,14 @@ def _edge_cone(ax: float, ay: float, dx: float, dy: float, px: np.ndarray, py: n
             lo = min(lo, n - e_n - sh)
         if g >= e_g:
             hi = min(hi, n + e_n + sh)
-    if whole:
+    if cone.whole:
         return lo, hi
     for b in range(2):
-        wx, wy, e_w = (w0x, w0y, e_w0) if b == 0 else (w1x, w1y, e_w1)
+        wx, wy, e_w = (cone.w0x, cone.w0y, cone.e_w0) if b == 0 else (cone.w1x, cone.w1y, cone.e_w1)
         den = wx * dy - wy * dx
         e_den = (2.0 * e_w + 12.0 * _U) * (abs(dx) + abs(dy)) + 8.0 * _ETA
         if not abs(den) > 2.0 * e_den:  # ill-conditioned: the edge runs along the ray
-            lo = min(lo, seg - sh)
+            lo = min(lo, edge.seg - sh)
             continue
         q = abs(den) - e_den
         for side in range(2):  # the backward apex (lower bound), then the forward one (upper bound)
@@ -286,7 +322,7 @@ def sector_bounds_kernel(x: float, y: float, th: float, alpha: np.ndarray, gamma
     reach2 = r2 * r2 * (1.0 + 16.0 * _U)
     px, py, pn, pe = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     for k in range(E):
-        if not _near(bbox, k, x, y, reach2):
+        if not edge_near(bbox, k, x, y, reach2):
             continue
         ax, ay = edges[k, 0] - x, edges[k, 1] - y
         dx, dy = edges[k, 2] - edges[k, 0], edges[k, 3] - edges[k, 1]
@@ -306,12 +342,13 @@ def sector_bounds_kernel(x: float, y: float, th: float, alpha: np.ndarray, gamma
             pe[j] = e_pt + 4.0 * _LU * pn[j]
             seg = min(seg, pn[j] - pe[j])
         near = seg - shift_max * (1.0 + 16.0 * _U)  # no apex is nearer to any point of the edge
+        edge = _Edge(ax, ay, dx, dy, npts, seg, e_pt)
         for s in range(S):
             if not math.isfinite(back[s]) or (near >= lo[s] and near >= hi[s]):
                 continue
-            d_lo, d_hi = _edge_cone(ax, ay, dx, dy, px, py, pn, pe, npts, seg, e_pt, ux[s], uy[s], cg[s],
-                                    w[s, 0], w[s, 1], w[s, 2], w[s, 3], e_u[s], e_w[s, 0], e_w[s, 1], sh[s],
-                                    whole[s])  # fmt: skip
+            cone = _ConeBounds(ux[s], uy[s], cg[s], w[s, 0], w[s, 1], w[s, 2], w[s, 3], e_u[s], e_w[s, 0],
+                               e_w[s, 1], sh[s], whole[s])  # fmt: skip
+            d_lo, d_hi = _edge_cone(edge, px, py, pn, pe, cone)
             lo[s], hi[s] = min(lo[s], d_lo), min(hi[s], d_hi)
     cap = reach * (1.0 - 16.0 * _U) - 1.5 * perr - 4.0 * _U * mag
     for s in range(S):
@@ -324,7 +361,9 @@ def sector_bounds_kernel(x: float, y: float, th: float, alpha: np.ndarray, gamma
 
 __all__ = [
     "edge_boxes",
+    "edge_near",
     "points_edges_kernel",
     "sector_bounds_kernel",
     "sector_kernel",
+    "segment_distance",
 ]

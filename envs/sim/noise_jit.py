@@ -21,6 +21,7 @@ Example (adversarial noise: the truth is a bound):
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -68,31 +69,94 @@ def _pad(v: float, tol: float, sign: float) -> float:
     return v + sign * (tol * max(1.0, a))
 
 
-@njit
-def record_kernel(r_b: np.ndarray, r_max: np.ndarray, s_lo: float, s_hi: float,
-                  w_lo: float, w_hi: float, heading: float, b_speed: float, b_yaw: float, b_heading: float,
-                  b_range: float, u: np.ndarray, model: int, bias: float, flag: np.ndarray, o_lo: np.ndarray,
-                  o_hi: np.ndarray, tol: float, out: np.ndarray, no_echo: np.ndarray) -> int:  # fmt: skip
-    """Intervals of one step into ``out (n + 3, 2)`` (speed, yaw rate, heading, then ranges); ``no_echo``.
+class StepTruth(NamedTuple):
+    """The true values of one step that its record bounds (:func:`record_kernel`).
 
-    ``s_lo, s_hi, w_lo, w_hi`` are the speed and yaw-rate hulls and ``heading`` the true heading;
-    ``r_b (n, 2)`` bounds each true sector distance (``[r, r]`` where it is known exactly; ``inf`` where
-    nothing lies in the sector); ``b_*`` the noise bounds; ``u`` the ``n + 3`` uniform draws;
-    ``flag, o_lo, o_hi`` the outliers replacing range readings. A hull ``[lo, hi]`` is reported as the noisy
-    interval of its midpoint widened by its half-width, so it contains the whole hull (under
-    ``adversarial`` noise the hull touches a bound). A reading is ``no_echo`` (``[r_max, inf]``) only when
-    the lower bound exceeds ``r_max``; one whose upper bound is not finite reads ``[min(lo, r_max), inf]``.
-    ``tol`` widens every finite bound by ``tol * max(1, |bound|)`` (0 when the truths are rigorous).
-    Returns the first row whose interval has a NaN or ``lo > hi`` (the checks of
+    Attributes:
+        range_bounds: ``(n, 2)`` bounds of each true sector distance (``[r, r]`` where it is known exactly;
+            ``inf`` where nothing lies in the sector).
+        speed_lo, speed_hi: the hull of the true forward (body-frame) velocities over the step.
+        yaw_lo, yaw_hi: the hull of the true yaw rates over the step.
+        heading: the true heading at the record.
+        lateral_lo, lateral_hi: the hull of the true leftward (body-frame) velocities over the step.
+        measure_lateral: whether the leftward velocity is measured (a Doppler velocity log, with the speed's
+            noise bound; pymunk dynamics) or known to lie in its hull (a unicycle: ``[0, 0]`` exactly,
+            recorded as it is, with no draw).
+    """
+
+    range_bounds: np.ndarray
+    speed_lo: float
+    speed_hi: float
+    yaw_lo: float
+    yaw_hi: float
+    heading: float
+    lateral_lo: float = 0.0
+    lateral_hi: float = 0.0
+    measure_lateral: bool = False
+
+
+class RecordModel(NamedTuple):
+    """How a record is made from the truth (:func:`record_kernel`): the sensors' ranges and the noise,
+    fixed for a sensor suite and a noise configuration (built once, :func:`.sensors.measure_step`).
+
+    Attributes:
+        r_max: ``(n,)`` the sensors' maximum ranges.
+        model: ``UNIFORM``, ``ADVERSARIAL`` or ``BIASED`` (:data:`MODEL_CODES`); bias: the ``biased`` share.
+        speed, yaw_rate, heading, range: the noise bounds of each kind of reading (``speed`` bounds both
+            body-frame velocity components).
+        tol: widens every finite bound by ``tol * max(1, |bound|)`` (0 when the truths are rigorous).
+    """
+
+    r_max: np.ndarray
+    model: int
+    bias: float
+    speed: float
+    yaw_rate: float
+    heading: float
+    range: float
+    tol: float
+
+
+@njit
+def record_kernel(truth: StepTruth, noise: RecordModel, u: np.ndarray, outlier: np.ndarray,
+                  outlier_lo: np.ndarray, outlier_hi: np.ndarray, out: np.ndarray, no_echo: np.ndarray
+                  ) -> int:  # fmt: skip
+    """Intervals of one step into ``out (n + 4, 2)`` (speed, yaw rate, heading, the ``n`` ranges, then the
+    lateral velocity); ``no_echo``.
+
+    ``truth`` holds the speed, yaw-rate and lateral hulls, the true heading and the bounds of each true
+    sector distance (:class:`StepTruth`); ``noise`` the maximum ranges, the noise model and its bounds
+    (:class:`RecordModel`); ``u`` the step's uniform draws in ``[-1, 1)``: ``n + 3`` (speed, yaw rate,
+    heading, then the ranges), plus one for the lateral velocity when it is measured (its interval then
+    follows the speed's noise model and bound; unmeasured, it is the hull itself, unwidened, so a unicycle
+    draws exactly what it drew before the lateral velocity existed); ``outlier`` (bool) the range readings
+    replaced by an outlier, whose
+    intervals are ``[outlier_lo, outlier_hi]``. A hull ``[lo, hi]`` is reported as the noisy interval of
+    its midpoint widened by its half-width, so it contains the whole hull (under ``adversarial`` noise the
+    hull touches a bound). A reading is ``no_echo`` (``[r_max, inf]``) only when the lower bound exceeds
+    ``r_max``; one whose upper bound is not finite reads ``[min(lo, r_max), inf]``. Every finite bound is
+    widened by ``noise.tol``. Returns the first row whose interval has a NaN or ``lo > hi`` (the checks of
     :class:`~digslam.observer.slam.record.MissionRecord`), -1 if none.
     """
+    r_b, r_max = truth.range_bounds, noise.r_max
+    model, bias, b_range, tol = noise.model, noise.bias, noise.range, noise.tol
+    flag, o_lo, o_hi = outlier, outlier_lo, outlier_hi
     n = r_b.shape[0]
-    for k in range(2):
-        h_lo, h_hi, b = (s_lo, s_hi, b_speed) if k == 0 else (w_lo, w_hi, b_yaw)
+    lat = n + 3
+    for k in range(3):
+        if k == 0:
+            h_lo, h_hi, b, row, draw = truth.speed_lo, truth.speed_hi, noise.speed, 0, 0
+        elif k == 1:
+            h_lo, h_hi, b, row, draw = truth.yaw_lo, truth.yaw_hi, noise.yaw_rate, 1, 1
+        else:
+            h_lo, h_hi, b, row, draw = truth.lateral_lo, truth.lateral_hi, noise.speed, lat, lat
+            if not truth.measure_lateral:
+                out[lat, 0], out[lat, 1] = h_lo, h_hi
+                continue
         half = 0.5 * (h_hi - h_lo)
-        _, lo, hi = _one(0.5 * (h_lo + h_hi), b, u[k], model, bias)
-        out[k, 0], out[k, 1] = min(lo - half, h_lo), max(hi + half, h_hi)  # exact containment of the hull
-    _, out[2, 0], out[2, 1] = _one(heading, b_heading, u[2], model, bias)
+        _, lo, hi = _one(0.5 * (h_lo + h_hi), b, u[draw], model, bias)
+        out[row, 0], out[row, 1] = min(lo - half, h_lo), max(hi + half, h_hi)  # exact containment of the hull
+    _, out[2, 0], out[2, 1] = _one(truth.heading, noise.heading, u[2], model, bias)
     for s in range(n):
         a, z = r_b[s, 0], r_b[s, 1]
         no_echo[s] = not a <= r_max[s]
@@ -111,8 +175,8 @@ def record_kernel(r_b: np.ndarray, r_max: np.ndarray, s_lo: float, s_hi: float,
         else:
             out[3 + s, 0], out[3 + s, 1] = max(lo, 0.0), hi
     bad = -1
-    for k in range(n + 3):
-        if tol > 0:
+    for k in range(n + 4):
+        if tol > 0 and (k < lat or truth.measure_lateral):
             out[k, 0], out[k, 1] = _pad(out[k, 0], tol, -1.0), _pad(out[k, 1], tol, 1.0)
         if bad < 0 and not out[k, 0] <= out[k, 1]:
             bad = k
@@ -120,21 +184,23 @@ def record_kernel(r_b: np.ndarray, r_max: np.ndarray, s_lo: float, s_hi: float,
 
 
 @njit
-def obs_kernel(rng: np.ndarray, no_echo: np.ndarray, speed: np.ndarray, yaw: np.ndarray, heading: np.ndarray,
-               top: float, s_top: float, w_top: float, h_lo: float,
+def obs_kernel(rng: np.ndarray, no_echo: np.ndarray, speed: np.ndarray, lateral: np.ndarray, yaw: np.ndarray,
+               heading: np.ndarray, top: float, s_top: float, w_top: float, h_lo: float,
                h_hi: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
-    """The observation of a record: ranges capped at ``top``, ``no_echo`` as int8, the odometry ``(2, 2)``
-    clipped to ``±s_top`` and ``±w_top``, and the heading shifted by the multiple of ``2 pi`` nearest its
+    """The observation of a record: ranges capped at ``top``, ``no_echo`` as int8, the odometry ``(3, 2)``
+    (speed, lateral velocity, yaw rate) clipped to ``±s_top``, ``±s_top`` and ``±w_top``, and the heading
+    shifted by the multiple of ``2 pi`` nearest its
     midpoint (half to even, as ``np.round``), clipped to ``[h_lo, h_hi]``; all new arrays."""
     n = rng.shape[0]
     r, e = np.empty((n, 2)), np.empty(n, dtype=np.int8)
     for s in range(n):
         r[s, 0], r[s, 1] = min(rng[s, 0], top), min(rng[s, 1], top)
         e[s] = 1 if no_echo[s] else 0
-    odo = np.empty((2, 2))
+    odo = np.empty((3, 2))
     for j in range(2):
         odo[0, j] = min(max(speed[j], -s_top), s_top)
-        odo[1, j] = min(max(yaw[j], -w_top), w_top)
+        odo[1, j] = min(max(lateral[j], -s_top), s_top)
+        odo[2, j] = min(max(yaw[j], -w_top), w_top)
     k = np.rint(0.5 * (heading[0] + heading[1]) / (2 * math.pi)) * 2 * math.pi
     h = np.empty(2)
     for j in range(2):
@@ -144,6 +210,8 @@ def obs_kernel(rng: np.ndarray, no_echo: np.ndarray, speed: np.ndarray, yaw: np.
 
 __all__ = [
     "MODEL_CODES",
+    "RecordModel",
+    "StepTruth",
     "noise_kernel",
     "obs_kernel",
     "record_kernel",

@@ -1,20 +1,44 @@
-"""A disc robot with exact unicycle kinematics, blocked (never sliding) by the world's walls.
+"""A disc robot in a world of walls, moved by pymunk (default) or by exact unicycle kinematics.
 
-Motion model (the data contract of the guaranteed observer, see :mod:`.missions`): the robot follows the exact
-arcs of :mod:`.arc` at constant speed ``v_i`` with ``ψ`` linear over each piece, so ``ẋ = v (cos ψ, sin ψ)``
-holds at every instant. The heading the simulator stores is the true heading; the position it stores is within
+Both dynamics share one interface (:class:`RobotSim`): :meth:`~RobotSim.step` advances one step and leaves
+behind rigorous hulls of the true forward velocity (:attr:`~RobotSim.speed_hull`), leftward velocity
+(:attr:`~RobotSim.lateral_hull`) and yaw rate (:attr:`~RobotSim.yaw_hull`) over the whole step, the true
+pose and a proved bound on its position error (:attr:`~RobotSim.pose_error`). Each is the data contract of
+the guaranteed observer (:mod:`digslam.observer.slam.record`): ``x' = R(psi) v`` with ``v = (v_1, v_2)``
+inside the hulls at every instant.
+
+**pymunk** (``dynamics="pymunk"``, the default). The robot is a pymunk body (a disc of mass 1 and the moment
+of a uniform disc of radius ``radius``) driven the way pymunk's own top-down examples drive one: a
+kinematic control body pulls it through a ``PivotJoint`` (``max_bias = 0``: a pure velocity constraint;
+``max_force``: the drive's force limit, so the body has inertia and lags the command) and a ``GearJoint``
+(``max_bias = 0``, ``max_force = max_torque``). Each substep the control body's velocity is set from the
+command ``(v, omega)`` in the body frame: ``v`` along the body's current heading, ``omega`` its angular
+velocity. Walls are static ``pymunk.Segment`` s with friction (:data:`WALL_FRICTION`) and no elasticity, so
+the robot skids along them and friction turns it; contacts are pymunk's. The collision circle has radius
+``radius + skin``. A step of ``dt`` seconds runs ``substeps`` pymunk steps whose durations are exact floats
+summing exactly to ``dt`` (:func:`.dynamics_jit.substep_times`). The truth is the piecewise-linear path
+through the states read back after each substep (:mod:`.dynamics_jit`: exact by definition, so
+``pose_error = 0``); its body-frame velocity and yaw rate are bounded rigorously over the step
+(:func:`.dynamics_jit.step_bounds`). **The premise by construction**: after every substep the disc of radius
+``radius`` centred anywhere on the segment from the previous state must be proved off every wall
+(:func:`.dynamics_jit.substep_clear`, rigorous float geometry that also catches tunnelling through thin
+walls). If it is not, the substep is undone: the body goes back to the previous state with zero velocity
+and angular velocity (a hard stop) and :attr:`~RobotSim.stops` counts it. The skin keeps pymunk's contacts
+off the disc, so hard stops are rare (``tests/envs/sim/test_dynamics.py``). A bump is a contact that begins
+while the robot touched no wall (pymunk's collision ``begin``).
+
+**unicycle** (``dynamics="unicycle"``, the thesis's missions' model). Exact unicycle kinematics, blocked
+(never sliding) by the world's walls: the robot follows the exact arcs of :mod:`.arc_jit` at constant speed
+``v_i`` with ``psi`` linear over each piece, so ``x' = v (cos psi, sin psi)`` holds at every instant and
+``v_2 = 0``. The heading the simulator stores is the true heading; the position it stores is within
 :attr:`RobotSim.pose_error` (a proved, accumulated bound) of the true one. ``v_i`` is the commanded speed up
 to the first substep whose sweep is blocked; the rest of the step runs, as one arc, at that speed scaled by
 the largest fraction in ``(1/2, 1/4, 1/8, 0)`` whose sweep is clear. A sweep is checked at the midpoints of
 ``m`` equal pieces of the arc with a margin of half a piece's travel (every point of the arc lies within that
 of a midpoint), so the nominal disc never overlaps an obstacle and never tunnels. Rotation in place is always
 allowed (the disc does not move). A bump is a step that gets blocked after an unblocked one. Each step runs
-compiled (:mod:`.robot_jit`).
-
-An earlier version drove the robot through pymunk joints: the body's velocity then lagged its heading (by up
-to 0.5 rad on reversals) and slid along walls, motions that no unicycle with the recorded heading explains,
-so the observer's tube could miss the truth. The pymunk space (walls, body, control body and joints) is
-still built and kept in sync, for reference ray casting (``benchmarks/bench_env.py``).
+compiled (:mod:`.robot_jit`). The pymunk space is still built and kept in sync, for reference ray casting
+(``benchmarks/bench_env.py``).
 """
 
 from __future__ import annotations
@@ -24,27 +48,40 @@ import math
 import numpy as np
 import pymunk
 
+from digslam.envs.config import DYNAMICS
 from digslam.envs.sim import geometry_jit as gjit
+from digslam.envs.sim.dynamics_jit import free_radius, step_bounds, substep_clear, substep_times
 from digslam.envs.sim.robot_jit import robot_step_kernel
 from digslam.envs.sim.world import World
 
 ROBOT_TYPE, WALL_TYPE = 1, 2
-#: Fractions of the commanded speed tried, in order, when a substep's sweep is blocked.
+#: Fractions of the commanded speed tried, in order, when a substep's sweep is blocked (unicycle).
 FRACTIONS = (1.0, 0.5, 0.25, 0.125)
-#: Sweep check points per substep.
+#: Sweep check points per substep (unicycle).
 SWEEP_POINTS = 4
+#: Friction coefficients of the walls and of the robot (pymunk multiplies them: 0.5 at a contact).
+WALL_FRICTION, ROBOT_FRICTION = 0.5, 1.0
 _FRACTIONS = np.array(FRACTIONS[1:])
+_NAN_PIECES = np.full((2, 3), np.nan)
+_NAN_PIECES.flags.writeable = False
+#: How far (m) the guard's fast path looks around a step's start; ``_GROW`` covers an L1 norm's rounding.
+_FREE_REACH, _GROW = 1.0, 1.0 + 2.0**-50
+# pymunk's property accessors, called directly (skips pymunk's per-instance ``__setattr__`` hook)
+_SET_V, _SET_W = pymunk.Body.velocity.fset, pymunk.Body.angular_velocity.fset
+_GET_P, _GET_A = pymunk.Body.position.fget, pymunk.Body.angle.fget
 
 
 class RobotSim:
-    """The robot's exact kinematics, plus a pymunk space holding the world's walls and the robot.
+    """The robot: pymunk dynamics with a premise guard, or exact unicycle kinematics (see the module).
 
     Args:
         world: Ground-truth world; each edge becomes a static ``pymunk.Segment``.
-        radius: Robot radius (m).
+        radius: Robot radius (m): the disc the premise keeps off every wall.
         pose: Start pose ``(x, y, theta)``.
-        skin: Extra radius of the pymunk collision disc (reference loop only; the kinematics use ``radius``).
-        max_force, max_torque: Joint limits of the pymunk reference loop only.
+        max_force, max_torque: Force and torque limits of the drive joints (pymunk dynamics; for the unicycle,
+            of the reference loop only).
+        skin: Extra radius of the pymunk collision disc.
+        dynamics: ``"pymunk"`` (default) or ``"unicycle"``.
     """
 
     def __init__(
@@ -55,7 +92,11 @@ class RobotSim:
         max_force: float = 50.0,
         max_torque: float = 50.0,
         skin: float = 0.02,
+        dynamics: str = "pymunk",
     ) -> None:
+        if dynamics not in DYNAMICS:
+            raise ValueError(f"dynamics: must be one of {DYNAMICS}, got {dynamics!r}")
+        self.dynamics = dynamics
         self.space = pymunk.Space()
         self.space.collision_slop = 1e-4
         self.space.iterations = 20
@@ -64,7 +105,7 @@ class RobotSim:
             if x1 == x2 and y1 == y2:
                 continue
             seg = pymunk.Segment(self.space.static_body, (x1, y1), (x2, y2), 0.0)
-            seg.collision_type, seg.friction, seg.elasticity = WALL_TYPE, 0.0, 0.0
+            seg.collision_type, seg.friction, seg.elasticity = WALL_TYPE, WALL_FRICTION, 0.0
             walls.append(seg)
         self.space.add(*walls)
         mass = 1.0
@@ -72,7 +113,11 @@ class RobotSim:
         self.body.position = (float(pose[0]), float(pose[1]))
         self.body.angle = float(pose[2])
         self.shape = pymunk.Circle(self.body, radius + skin)
-        self.shape.collision_type, self.shape.friction, self.shape.elasticity = ROBOT_TYPE, 0.0, 0.0
+        self.shape.collision_type, self.shape.friction, self.shape.elasticity = (
+            ROBOT_TYPE,
+            ROBOT_FRICTION,
+            0.0,
+        )
         self.control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
         self.control.position, self.control.angle = self.body.position, self.body.angle
         pivot = pymunk.PivotJoint(self.control, self.body, (0, 0), (0, 0))
@@ -80,40 +125,109 @@ class RobotSim:
         gear = pymunk.GearJoint(self.control, self.body, 0.0, 1.0)
         gear.max_bias, gear.max_force = 0.0, float(max_torque)
         self.space.add(self.body, self.shape, self.control, pivot, gear)
-        self.bumps = 0
-        self.space.on_collision(ROBOT_TYPE, WALL_TYPE, begin=self._on_bump)
+        #: Bumps since construction; hard stops of the premise guard (pymunk).
+        self.bumps, self.stops = 0, 0
+        self._touching = 0
+        if dynamics == "pymunk":
+            self.space.on_collision(ROBOT_TYPE, WALL_TYPE, begin=self._begin, separate=self._separate)
         self.radius = float(radius)
         self.edges = np.ascontiguousarray(world.edges, dtype=np.float64)
         self.bbox = gjit.edge_boxes(self.edges)
         self._pose = np.array([float(pose[0]), float(pose[1]), float(pose[2])])
-        self._v, self._w, self._blocked = 0.0, 0.0, False
+        self._v, self._w, self._lat, self._blocked = 0.0, 0.0, 0.0, False
         self.speed_hull: tuple[float, float] = (0.0, 0.0)
+        self.lateral_hull: tuple[float, float] = (0.0, 0.0)
         self.yaw_hull: tuple[float, float] = (0.0, 0.0)
-        #: The last step's pieces ``(v, tau, theta_end)`` (:mod:`.arc`); at reset, at rest.
+        #: The last step's pieces ``(v, tau, theta_end)`` (:mod:`.arc_jit`; unicycle; NaN under pymunk); at
+        #: reset, at rest.
         self.pieces = np.array([[0.0, 0.0, self._pose[2]], [0.0, 0.0, self._pose[2]]])
-        #: Proved bound on ``max(|x - x_true|, |y - y_true|)`` of :attr:`pose` (the heading is exact).
+        #: The last step's path (pymunk): the states ``(S + 1, 3)`` (``x, y, angle`` before the step and
+        #: after each substep) and the substep durations ``(S,)``; empty before the first step and under the
+        #: unicycle. Fresh arrays each step, never written afterwards.
+        self.states = np.zeros((0, 3))
+        self.taus = np.zeros(0)
+        #: Proved bound on ``max(|x - x_true|, |y - y_true|)`` of :attr:`pose` (the heading is exact; 0 under
+        #: pymunk, whose stored states are the truth).
         self.pose_error = 0.0
+        self._hulls = np.zeros((3, 2))
+        self._times: dict[tuple[float, int], tuple[np.ndarray, list[float]]] = {}
 
-    def _on_bump(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
-        pass  # contacts of the reference pymunk loop (benchmarks) are not the robot's bumps
+    def _begin(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
+        if self._touching == 0:
+            self.bumps += 1
+        self._touching += 1
+
+    def _separate(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
+        self._touching = max(self._touching - 1, 0)
 
     def step(self, v: float, omega: float, dt: float, substeps: int) -> int:
         """Advance ``dt`` seconds under command ``(v, omega)``; return the bumps that occurred.
 
-        ``dt`` must be the exact time between the step's two records (:func:`.arc.exact_duration`). The
-        substeps before the first blocked one run at full speed; the rest of the step runs at the largest
-        fraction of :data:`FRACTIONS` (or 0) whose sweep is clear, as one arc (compiled,
-        :func:`.robot_jit.robot_step_kernel`). Afterwards :attr:`speed_hull` and :attr:`yaw_hull` bound the
-        true speed and yaw rate over the whole step (the yaw rate outward-rounded), :attr:`pieces` holds the
-        step's pieces ``(v, tau, theta_end)`` and :attr:`pose_error` the accumulated position-error bound.
+        ``dt`` must be the exact time between the step's two records (:func:`.arc_jit.exact_duration`).
+        Afterwards :attr:`speed_hull`, :attr:`lateral_hull` and :attr:`yaw_hull` bound the true body-frame
+        velocity and yaw rate over the whole step (outward-rounded), :attr:`pose` is the true pose (within
+        :attr:`pose_error`), and :attr:`states` / :attr:`taus` (pymunk) or :attr:`pieces` (unicycle) hold the
+        step's exact motion.
         """
-        v, omega = float(v), float(omega)
+        if self.dynamics == "pymunk":
+            return self._step_pymunk(float(v), float(omega), float(dt), int(substeps))
+        return self._step_unicycle(float(v), float(omega), float(dt), int(substeps))
+
+    def _step_pymunk(self, v: float, omega: float, dt: float, substeps: int) -> int:
+        key = (dt, substeps)
+        got = self._times.get(key)
+        if got is None:  # the durations of a step length, computed once (shared, read-only)
+            taus = substep_times(dt, substeps)
+            taus.flags.writeable = False
+            if len(self._times) > 64:
+                self._times.clear()
+            got = self._times[key] = (taus, taus.tolist())
+        taus, tau_list = got
+        x, y, a = self._pose.tolist()
+        x0, y0, rows = x, y, [(x, y, a)]
+        body, control, step = self.body, self.control, self.space.step
+        radius, edges, bbox = self.radius, self.edges, self.bbox
+        # the fast path of the guard: a substep whose ends lie within `free` of the start is clear
+        free = free_radius(x0, y0, radius, _FREE_REACH, edges, bbox)
+        inside = free > 0.0
+        bumps = self.bumps
+        _SET_W(control, omega)
+        for tau in tau_list:
+            _SET_V(control, (v * math.cos(a), v * math.sin(a)))
+            step(tau)
+            x1, y1 = _GET_P(body)
+            a1 = _GET_A(body)
+            near = (abs(x1 - x0) + abs(y1 - y0)) * _GROW < free  # |p1 - p0| < free, rounding included
+            if not (inside and near) and not substep_clear(x, y, x1, y1, radius, edges, bbox):
+                self.stops += 1  # undo the substep: a hard stop
+                x1, y1, a1, near = x, y, a, inside
+                body.position, body.angle = (x, y), a
+                body.velocity, body.angular_velocity = (0.0, 0.0), 0.0
+            x, y, a, inside = x1, y1, a1, near
+            rows.append((x, y, a))
+        states = np.array(rows)
+        self._pose[0], self._pose[1], self._pose[2] = x, y, a
+        h = self._hulls
+        step_bounds(states, taus, h)
+        self.speed_hull = (float(h[0, 0]), float(h[0, 1]))
+        self.lateral_hull = (float(h[1, 0]), float(h[1, 1]))
+        self.yaw_hull = (float(h[2, 0]), float(h[2, 1]))
+        # the true velocity at the step's end (floats): the last substep's, in the body frame at angle a_S
+        tau, (xp, yp, ap) = tau_list[-1], rows[-2]
+        ux, uy = (x - xp) / tau, (y - yp) / tau
+        c, s = math.cos(a), math.sin(a)
+        self._v, self._lat, self._w = c * ux + s * uy, c * uy - s * ux, (a - ap) / tau
+        self.states, self.taus = states, taus
+        self.pieces = _NAN_PIECES
+        return self.bumps - bumps
+
+    def _step_unicycle(self, v: float, omega: float, dt: float, substeps: int) -> int:
         first, vi, err, w_lo, w_hi = robot_step_kernel(
             self._pose,
             v,
             omega,
-            float(dt),
-            int(substeps),
+            dt,
+            substeps,
             SWEEP_POINTS,
             self.radius,
             self.edges,
@@ -145,14 +259,28 @@ class RobotSim:
 
     @property
     def speed(self) -> float:
-        """True forward speed (velocity projected on the heading, m/s)."""
+        """True forward velocity ``v_1`` at the step's end (m/s; unicycle: the speed of the last piece)."""
         return self._v
 
     @property
+    def lateral(self) -> float:
+        """True leftward velocity ``v_2`` at the step's end (m/s; 0 for the unicycle)."""
+        return self._lat
+
+    @property
     def yaw_rate(self) -> float:
-        """True yaw rate (rad/s), to within an ulp: the middle of :attr:`yaw_hull` (the exact rates are
-        ``(theta_end - theta_start) / tau`` of :attr:`pieces`)."""
+        """True yaw rate at the step's end (rad/s): pymunk, the last substep's (to within float rounding);
+        unicycle, the middle of :attr:`yaw_hull` (the exact rates are ``(theta_end - theta_start) / tau`` of
+        :attr:`pieces`), to within an ulp."""
         return self._w
 
 
-__all__ = ["FRACTIONS", "ROBOT_TYPE", "SWEEP_POINTS", "WALL_TYPE", "RobotSim"]
+__all__ = [
+    "FRACTIONS",
+    "ROBOT_TYPE",
+    "ROBOT_FRICTION",
+    "SWEEP_POINTS",
+    "WALL_FRICTION",
+    "WALL_TYPE",
+    "RobotSim",
+]

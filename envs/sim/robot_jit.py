@@ -26,33 +26,43 @@ run, then the disc touches the wall and stops):
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
 from digslam.envs.sim.arc_jit import advance, yaw_rate_bounds
-from digslam.envs.sim.geometry_jit import _near, _seg_dist
+from digslam.envs.sim.geometry_jit import edge_near, segment_distance
 from digslam.observer.core.scalar_jit import add_up, njit
 
 
+class _NearEdges(NamedTuple):
+    """The edges a step may meet: ``edges[idx[:n]]`` of the world's ``(E, 4)`` edge array."""
+
+    edges: np.ndarray
+    idx: np.ndarray
+    n: int
+
+
 @njit(inline="always")
-def _clear(x: float, y: float, edges: np.ndarray, idx: np.ndarray, n: int, need: float) -> bool:
-    """Whether ``(x, y)`` lies at least ``need`` from each of the edges ``idx[:n]``."""
-    for q in range(n):
+def _clear(x: float, y: float, near: _NearEdges, need: float) -> bool:
+    """Whether ``(x, y)`` lies at least ``need`` from each of the edges ``near``."""
+    edges, idx = near.edges, near.idx
+    for q in range(near.n):
         k = idx[q]
         ax, ay = edges[k, 0] - x, edges[k, 1] - y
-        if _seg_dist(ax, ay, edges[k, 2] - edges[k, 0], edges[k, 3] - edges[k, 1]) < need:
+        if segment_distance(ax, ay, edges[k, 2] - edges[k, 0], edges[k, 3] - edges[k, 1]) < need:
             return False
     return True
 
 
 @njit(inline="always")
 def _sweep(x: float, y: float, th: float, v: float, w: float, pieces: int, piece: float, radius: float,
-           edges: np.ndarray, idx: np.ndarray, n: int) -> int:  # fmt: skip
+           near: _NearEdges) -> int:  # fmt: skip
     """Index of the first blocked piece midpoint of the arc (``pieces`` if none is)."""
     need = radius + abs(v) * (0.5 * piece)
     for j in range(pieces):
         px, py, _, _ = advance(x, y, th, v, w, (j + 0.5) * piece)
-        if not _clear(px, py, edges, idx, n, need):
+        if not _clear(px, py, near, need):
             return j
     return pieces
 
@@ -88,14 +98,15 @@ def robot_step_kernel(pose: np.ndarray, v: float, w: float, dt: float, substeps:
     n = 0
     dmin = math.inf
     for k in range(edges.shape[0]):
-        if _near(bbox, k, x, y, reach2):
+        if edge_near(bbox, k, x, y, reach2):
             idx[n] = k
             n += 1
-            dmin = min(dmin, _seg_dist(edges[k, 0] - x, edges[k, 1] - y, edges[k, 2] - edges[k, 0],
+            dmin = min(dmin, segment_distance(edges[k, 0] - x, edges[k, 1] - y, edges[k, 2] - edges[k, 0],
                                        edges[k, 3] - edges[k, 1]))  # fmt: skip
+    near = _NearEdges(edges, idx, n)
     first = substeps
     if v != 0.0 and not dmin > radius + abs(v) * dt * (1.0 + 1e-9) + 1e-9:
-        first = _sweep(x, y, th, v, w, substeps * m, piece, radius, edges, idx, n) // m
+        first = _sweep(x, y, th, v, w, substeps * m, piece, radius, near) // m
     rest = substeps - first
     vi = v
     # durations that sum to dt exactly: t2 = dt - t1 is exact when t1 >= dt / 2 (Sterbenz), else t1 is
@@ -117,7 +128,7 @@ def robot_step_kernel(pose: np.ndarray, v: float, w: float, dt: float, substeps:
     if rest:
         vi = 0.0
         for f in fractions:
-            if _sweep(x, y, th, v * f, w, rest * m, piece, radius, edges, idx, n) == rest * m:
+            if _sweep(x, y, th, v * f, w, rest * m, piece, radius, near) == rest * m:
                 vi = v * f
                 break
         th0 = th

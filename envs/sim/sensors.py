@@ -4,7 +4,10 @@ Range truth is geometric (the exact sector distance of :mod:`.geometry` over the
 bounding boxes), never a ray fan. The omnidirectional sensor is a cone of half-aperture ``pi``.
 
 Odometry may be given as a hull ``(lo, hi)`` of the true values over a time slice (the env passes the hull
-over the pieces of the step that just ended); the reported interval then contains the whole hull. Ranges
+over the substeps or pieces of the step that just ended); the reported interval then contains the whole
+hull. Odometry is the body-frame velocity ``(v_1, v_2)`` (forward, leftward: a Doppler velocity log whose
+two components share the noise bound ``NoiseConfig.speed``) and the yaw rate; a robot that cannot slip
+(the unicycle) records ``v_2 = [0, 0]``, the known constraint, unmeasured. Ranges
 may likewise be given as rigorous bounds ``(n, 2)`` of the true distances: :meth:`SensorSuite.range_bounds`
 computes them from the simulator's pose and its proved pose error (:mod:`.arc`), so the record contains
 the exact truth, floating point included, with no tolerance chosen by hand. ``tol`` is an optional extra
@@ -22,7 +25,7 @@ import numpy as np
 from digslam.envs.config import ExploreConfig, NoiseConfig
 from digslam.envs.sim import geometry_jit as gjit
 from digslam.envs.sim.noise import outliers
-from digslam.envs.sim.noise_jit import MODEL_CODES, record_kernel
+from digslam.envs.sim.noise_jit import MODEL_CODES, RecordModel, StepTruth, record_kernel
 from digslam.envs.sim.world import World
 from digslam.observer.slam.record import MissionRecord
 
@@ -67,6 +70,7 @@ class SensorSuite:
         # kernel keeps the first (uncached) compilation short
         for name in ("alpha", "gamma", "r_max"):
             object.__setattr__(self, "_k_" + name, getattr(self, name).copy())
+        object.__setattr__(self, "_model", (None, None, None))  # (noise, tol, its RecordModel): measure_step
 
     @classmethod
     def from_config(cls, cfg: ExploreConfig) -> SensorSuite:
@@ -117,6 +121,7 @@ def measure_step(
     noise: NoiseConfig,
     rng: np.random.Generator,
     tol: float = 0.0,
+    lateral: Hull | None = None,
 ) -> MissionRecord:
     """Noisy record of one step from the true values.
 
@@ -124,10 +129,14 @@ def measure_step(
     rigorous bounds ``(n, 2)`` of them (:meth:`SensorSuite.range_bounds`). ``speed`` and ``yaw_rate`` are
     true values or hulls ``(lo, hi)`` of true values; the interval reported for a hull is the noisy interval
     of its midpoint widened by its half-width, so it contains the whole hull (under ``adversarial`` noise
-    the hull touches a bound). The random generator is advanced by the same amount whatever the values, so
-    runs stay reproducible.
+    the hull touches a bound). ``lateral`` is the leftward velocity (value or hull), measured like the speed
+    (same noise bound ``noise.speed``, one more draw); None (a unicycle) records ``[0, 0]`` exactly with no
+    draw. The random generator is advanced by the same amount whatever the values, so runs stay
+    reproducible.
     """
     (s_lo, s_hi), (w_lo, w_hi) = _hull(speed), _hull(yaw_rate)
+    measured = lateral is not None
+    l_lo, l_hi = _hull(lateral) if measured else (0.0, 0.0)  # type: ignore[arg-type]
     n = suite.n
     r = ranges
     if not (type(r) is np.ndarray and r.dtype == np.float64 and r.shape == (n, 2) and r.flags.c_contiguous):
@@ -137,19 +146,21 @@ def measure_step(
         elif r.shape != (n, 2):
             raise ValueError(f"ranges: expected shape ({n},) or ({n}, 2), got {r.shape}")
         r = np.ascontiguousarray(r)
-    u = rng.uniform(-1.0, 1.0, n + 3)
+    u = rng.uniform(-1.0, 1.0, n + 4 if measured else n + 3)
     if noise.outlier_prob > 0:
         flag, o_lo, o_hi = outliers(n, noise.outlier_prob, suite.r_max, noise.range, rng, noise.max_outliers)
     else:
         flag = np.zeros(n, dtype=bool)
         o_lo = o_hi = suite._k_r_max
-    out, no_echo = np.empty((n + 3, 2)), np.empty(n, dtype=bool)
-    bad = record_kernel(r, suite._k_r_max, s_lo, s_hi, w_lo, w_hi, float(heading),
-                        float(noise.speed), float(noise.yaw_rate), float(noise.heading),
-                        float(noise.range), u, MODEL_CODES[noise.model], float(noise.bias), flag, o_lo,
-                        o_hi, float(tol), out, no_echo)  # fmt: skip
+    out, no_echo = np.empty((n + 4, 2)), np.empty(n, dtype=bool)
+    model = suite._model  # the kernel's RecordModel, built once per noise configuration
+    if model[0] is not noise or model[1] != tol:
+        model = (noise, tol, _record_model(suite, noise, tol))
+        object.__setattr__(suite, "_model", model)
+    truth = StepTruth(r, s_lo, s_hi, w_lo, w_hi, float(heading), l_lo, l_hi, measured)
+    bad = record_kernel(truth, model[2], u, flag, o_lo, o_hi, out, no_echo)
     if bad >= 0:
-        name = _ROWS[bad] if bad < 3 else f"range[{bad - 3}]"
+        name = _ROWS[bad] if bad < 3 else ("lateral" if bad == n + 3 else f"range[{bad - 3}]")
         raise ValueError(f"{name}: interval is not [lo <= hi]: {out[bad].tolist()}")
     t = float(t)
     if not math.isfinite(t):
@@ -157,12 +168,19 @@ def measure_step(
     return _record(t, out, suite, no_echo, flag)
 
 
+def _record_model(suite: SensorSuite, noise: NoiseConfig, tol: float) -> RecordModel:
+    """The :class:`.noise_jit.RecordModel` of ``suite`` under ``noise`` and the widening ``tol``."""
+    nz = noise
+    bounds = (float(nz.speed), float(nz.yaw_rate), float(nz.heading), float(nz.range))
+    return RecordModel(suite._k_r_max, MODEL_CODES[nz.model], float(nz.bias), *bounds, float(tol))
+
+
 def _record(
     t: float, out: np.ndarray, suite: SensorSuite, no_echo: np.ndarray, flag: np.ndarray
 ) -> MissionRecord:
     """A :class:`MissionRecord` built from arrays already of the right dtype and shape, whose intervals
     :func:`record_kernel` has checked: the same fields as ``MissionRecord(...)``, without re-running its
-    per-field conversions and checks each step (``tests/test_sim_jit.py`` checks the two agree)."""
+    per-field conversions and checks each step (``tests/envs/sim/test_kernels.py`` checks the two agree)."""
     rec = MissionRecord.__new__(MissionRecord)
     rec.__dict__.update(
         t=np.asarray(t, dtype=np.float64),
@@ -172,9 +190,10 @@ def _record(
         alpha=suite.alpha,
         gamma=suite.gamma,
         r_max=suite.r_max,
-        range=out[3:],
+        range=out[3:-1],
         no_echo=no_echo,
         outlier=flag,
+        lateral=out[-1],
     )
     return rec
 

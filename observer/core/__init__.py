@@ -9,7 +9,8 @@ aliases ``Pair``, ``Batch``), :mod:`.config` (the one config base), :mod:`.cache
 ``njit``
 with the project's settings and every scalar outward-rounded primitive), :mod:`.polar_ops_jit` and
 :mod:`.polar_jit` (the minimal polar contractor, Sec. 4.3.2, a primitive of the expressions' ``atan2``
-backward step).
+backward step), :mod:`.angles_jit` (the axis directions an angle range may hold) and :mod:`.grid_jit` (the
+window of grid cells a box meets).
 
 May import: numpy, numba and the standard library; nothing else of ``digslam``.
 
@@ -34,6 +35,9 @@ from . import cache
 
 cache.guard()  # before any kernel is loaded: an edited kernel source never runs old compiled code
 
+from .angles_jit import (
+    axes_in,
+)
 from .arith import (
     abs_,
     add,
@@ -66,6 +70,22 @@ from .boxes import (
     width_euclid,
     width_inf,
     widths,
+)
+from .config import (
+    Config,
+    check,
+    check_choice,
+    check_finite_nonneg,
+    check_finite_pos,
+    check_in,
+    check_int,
+    config_dataclass,
+    is_int,
+    is_number,
+    reject_unknown,
+)
+from .grid_jit import (
+    window,
 )
 from .interval import (
     DEFER_TO,
@@ -119,10 +139,18 @@ from .scalar_jit import (
     add_dn,
     div_dn,
     dn,
+    iabs,
+    iadd,
     idiv,
+    iexp,
+    ilog,
     imul,
+    ipown,
     isqr,
     isqrt,
+    isub,
+    ixdiv,
+    meet,
     mul_dn,
     nil,
     njit,
@@ -153,6 +181,7 @@ __all__ = [
     "BoolArray",
     "Box",
     "CHUNK",
+    "Config",
     "DEFER_TO",
     "FloatArray",
     "HALF_PI_DOWN",
@@ -175,9 +204,17 @@ __all__ = [
     "asin",
     "atan",
     "atan2",
+    "axes_in",
     "bisect",
     "box_difference",
+    "check",
+    "check_choice",
+    "check_finite_nonneg",
+    "check_finite_pos",
+    "check_in",
+    "check_int",
     "chunked",
+    "config_dataclass",
     "contract_pos",
     "cos",
     "cos_sin",
@@ -194,14 +231,24 @@ __all__ = [
     "empty_rows",
     "exp",
     "hull",
+    "iabs",
+    "iadd",
     "idiv",
+    "iexp",
+    "ilog",
     "imul",
     "intersect",
+    "ipown",
+    "is_int",
+    "is_number",
     "isqr",
     "isqrt",
+    "isub",
+    "ixdiv",
     "lift",
     "log",
     "maximum",
+    "meet",
     "midpoint",
     "minimum",
     "mul",
@@ -219,6 +266,7 @@ __all__ = [
     "pmul",
     "point_angle",
     "pown",
+    "reject_unknown",
     "sep_pie_batch",
     "set_empty",
     "sin",
@@ -243,5 +291,6 @@ __all__ = [
     "width_euclid",
     "width_inf",
     "widths",
+    "window",
     "wup",
 ]

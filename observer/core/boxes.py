@@ -54,7 +54,7 @@ def validate_batch(lo: Any, hi: Any, name: str = "boxes", n: int | None = None) 
 
 def empty_rows(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """``(N,)`` mask of empty boxes."""
-    return (lo > hi).any(axis=-1)
+    return np.asarray((lo > hi).any(axis=-1))
 
 
 def normalize_empty(lo: np.ndarray, hi: np.ndarray) -> Batch:

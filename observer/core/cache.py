@@ -47,25 +47,30 @@ def _subpath(py_file: Path) -> str:
     return os.path.basename(parent) + "_" + hashlib.sha1(parent.encode()).hexdigest()
 
 
+def _numba_cache_dir() -> str:
+    """``NUMBA_CACHE_DIR`` as numba read it ("" when unset; numba sets its config attributes at run time)."""
+    from numba.core import config
+
+    return str(getattr(config, "CACHE_DIR", "") or "")
+
+
 def cache_dirs(py_file: Path) -> list[Path]:
     """The folders where numba may keep the caches of ``py_file``."""
-    from numba.core import config
     from numba.misc.appdirs import AppDirs
 
     dirs = [py_file.parent / "__pycache__", Path(AppDirs(appname="numba", appauthor=False).user_cache_dir)]
-    if config.CACHE_DIR:
-        dirs.insert(0, Path(config.CACHE_DIR))
+    if _numba_cache_dir():
+        dirs.insert(0, Path(_numba_cache_dir()))
     return [dirs[0] if d == py_file.parent / "__pycache__" else d / _subpath(py_file) for d in dirs]
 
 
 def stamp_path() -> Path:
     """Where the digest is kept: ``NUMBA_CACHE_DIR`` if set, else beside this file's caches (if writable),
     else numba's user-wide cache folder."""
-    from numba.core import config
     from numba.misc.appdirs import AppDirs
 
-    if config.CACHE_DIR:
-        return Path(config.CACHE_DIR) / STAMP
+    if _numba_cache_dir():
+        return Path(_numba_cache_dir()) / STAMP
     here = Path(__file__).resolve().parent / "__pycache__"
     try:
         here.mkdir(exist_ok=True)
@@ -90,11 +95,12 @@ def clear(files: Iterable[Path]) -> int:
     return n
 
 
-def guard() -> bool:
-    """Clear every kernel cache when a kernel source changed since the last stamp; True if it cleared."""
-    files = kernel_sources()
+def guard(roots: Iterable[Path] = ROOTS, stamp: Path | None = None) -> bool:
+    """Clear every kernel cache of ``roots`` when a kernel source changed since the last stamp (kept in
+    ``stamp``, default :func:`stamp_path`); True if it cleared."""
+    files = kernel_sources(roots)
     new = digest(files)
-    stamp = stamp_path()
+    stamp = stamp_path() if stamp is None else stamp
     try:
         old = stamp.read_text().strip()
     except OSError:

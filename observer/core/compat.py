@@ -22,7 +22,7 @@ OBSERVER: dict[str, str] = {
     "rounding": "core.rounding", "arith": "core.arith", "trig": "core.trig", "boxes": "core.boxes",
     "interval": "core.interval", "jit": "core.scalar_jit", "polar_jit": "core.polar_jit",
     "polar_jit_ops": "core.polar_ops_jit",
-    "expr": "expr.expr", "ops": "expr.ops", "backward": "expr.backward", "centred": "expr.centred",
+    "ops": "expr.ops", "backward": "expr.backward", "centred": "expr.centred",
     "jit_centred": "expr.centred_jit", "jit_tape": "expr.tape_jit", "jit_hc4": "expr.hc4_jit",
     "contractors": "sets.contractors", "separators": "sets.separators", "sep_inverse": "sets.sep_inverse",
     "sep_image": "sets.sep_image", "sep_polygon": "sets.sep_polygon", "transforms": "sets.transforms",

@@ -1,14 +1,14 @@
 """Compiled minimal polar contractor (thesis §3.2.3, Eq. 3.22–3.34): one machine-code loop per batch.
 
-The same construction as :mod:`.polar_ctc` (read its docstring): on ``ρ >= 0`` the hull of
+The construction of :mod:`digslam.observer.polar.ctc` (read its docstring): on ``ρ >= 0`` the hull of
 ``[x]×[y]×[ρ]×[θ] ∩ Π`` is the hull of the candidate extreme points (box corners, box edges ∩ circles
 ``|p| = ρ±``, box edges ∩ rays ``θ±``, rays ∩ circles, circles ∩ axes, feet of the edges on the
-axes, the origin), each enclosed with :mod:`.jit`'s outward-rounded scalar arithmetic, intersected
+axes, the origin), each enclosed with :mod:`.scalar_jit`'s outward-rounded scalar arithmetic, intersected
 with the box and kept when it may lie in the region (Eq. 3.28 on the base domain, the symmetries of
 Prop. 3.4 by taking all octants at once); ``σ₄`` (``ρ < 0``, Eq. 3.32) is applied explicitly, ``γ``
 (``θ + 2kπ``) by lifting each angle to its extreme representatives in ``[θ]``. A candidate is
-intersected with the box *before* its angle is taken, so the result is never larger than
-:func:`.polar_ctc.contract_polar`'s, which is kept as the test oracle.
+intersected with the box *before* its angle is taken, so the result is never larger than that of the
+numpy oracle of the tests (``tests/polar_oracle.py``).
 
 Example:
     >>> box = np.array([[1.0, 1.0, 0.0, -10.0]]), np.array([[2.0, 2.0, 10.0, 10.0]])

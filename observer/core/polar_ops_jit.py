@@ -1,6 +1,6 @@
 """Scalar kernels of the compiled polar contractor (:mod:`.polar_jit`): angles, sector sides, products.
 
-Each bound is stepped outward with :mod:`.jit` (``dn``/``up`` for ``+ - * /``, ``wdn``/``wup`` for
+Each bound is stepped outward with :mod:`.scalar_jit` (``dn``/``up`` for ``+ - * /``, ``wdn``/``wup`` for
 libm's ``cos``, ``sin``, ``atan2``); the sign tests of :func:`cross` carry an explicit error term.
 
 Example:

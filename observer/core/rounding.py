@@ -10,7 +10,8 @@ real result.
   moves one ulp outward unconditionally, which is sound (round-to-nearest is within half an ulp).
 * Transcendental functions come from the platform's libm (numpy may dispatch to SIMD code).
   Their documented error is at most :data:`LIBM_ULPS` ulps, so results are widened by that many ulps
-  (:func:`widen_down`, :func:`widen_up`). ``tests/test_rounding.py`` measures the real error against
+  (:func:`widen_down`, :func:`widen_up`). ``tests/observer/core/test_rounding.py`` measures the real error
+  against
   mpmath.
 
 This module does not change the processor's rounding mode, and must not run in a process where

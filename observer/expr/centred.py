@@ -35,7 +35,7 @@ import numpy as np
 
 from digslam.observer.core import arith as A
 from digslam.observer.core import trig as T
-from digslam.observer.core.boxes import midpoint
+from digslam.observer.core.boxes import empty_rows, midpoint
 from digslam.observer.core.types import Pair
 
 __all__ = ["jacobian", "centred_image", "jacobian_numpy", "centred_image_numpy"]
@@ -157,7 +157,7 @@ def jacobian_numpy(f: Any, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, 
     jlo = np.stack([ds[o][0] for o in f.outputs], axis=1)
     jhi = np.stack([ds[o][1] for o in f.outputs], axis=1)
     valid = np.stack([ok[o] for o in f.outputs], axis=1)
-    empty = (lo > hi).any(axis=1)
+    empty = empty_rows(lo, hi)
     jlo[empty], jhi[empty] = _INF, -_INF
     return jlo, jhi, valid & ~empty[:, None]
 
@@ -166,7 +166,7 @@ def centred_image_numpy(f: Any, lo: np.ndarray, hi: np.ndarray) -> Pair:
     """Mean-value form ``[f]({m}) + [J_f]([x])·([x] - m)`` (numpy), ``(N, m)``; ``ℝ`` on invalid rows,
     empty on empty boxes."""
     N = lo.shape[0]
-    empty = (lo > hi).any(axis=1)
+    empty = empty_rows(lo, hi)
     with np.errstate(invalid="ignore"):
         mid = np.where(empty[:, None], 0.0, midpoint(lo, hi))
     jlo, jhi, valid = jacobian_numpy(f, lo, hi)
@@ -185,8 +185,8 @@ def centred_image_numpy(f: Any, lo: np.ndarray, hi: np.ndarray) -> Pair:
 
 
 def jacobian(f: Any, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``[J_f]([x])`` on a batch ``(N, n)``: compiled on the :class:`~.jit_tape.Tape` when ``f`` has one
-    (:func:`.jit_centred.jacobian_tape`), else by numpy (:func:`jacobian_numpy`). Returns ``(Jlo, Jhi,
+    """``[J_f]([x])`` on a batch ``(N, n)``: compiled on the :class:`~.tape_jit.Tape` when ``f`` has one
+    (:func:`.centred_jit.jacobian_tape`), else by numpy (:func:`jacobian_numpy`). Returns ``(Jlo, Jhi,
     valid)`` with ``J`` of shape ``(N, m, n)`` and ``valid`` ``(N, m)`` as in :func:`jacobian_numpy`."""
     from digslam.observer.expr.centred_jit import jacobian_tape
     from digslam.observer.expr.tape_jit import Tape

@@ -1,11 +1,13 @@
-"""Compiled interval automatic differentiation and centred form on a :class:`~.jit_tape.Tape`.
+"""Compiled interval automatic differentiation and centred form on a :class:`~.tape_jit.Tape`.
 
 The compiled twin of :mod:`.centred` (read its docstring for the mathematics and the validity rule):
-forward-mode AD one box at a time, node by node along the tape, with :mod:`.jit`'s outward-rounded
-scalar interval operations. Per box it gives the interval Jacobian ``[J_f]([x])`` (Eq. 2.20) and the
-mean-value form ``[f]({m}) + [J_f]([x])·([x] - m)``. :func:`centre_outputs` intersects the latter into
-the output nodes of a forward pass, which is how :mod:`.jit_hc4` runs HC4 and the separator of
-Theorem 2.1 with ``centred=True``. :func:`.centred.jacobian_numpy` is its test oracle.
+forward-mode AD one box at a time, node by node along the tape, with the outward-rounded scalar interval
+primitives of :mod:`digslam.observer.core.scalar_jit`. Per box it gives the interval Jacobian
+``[J_f]([x])`` (Eq. 2.20) and the mean-value form ``[f]({m}) + [J_f]([x])·([x] - m)``.
+:func:`centre_outputs` intersects the latter into the output nodes of a forward pass, which is how
+:mod:`.hc4_jit` runs HC4 and the separator of Theorem 2.1 with ``centred=True``. The numpy path of
+:mod:`.centred` (:func:`.centred.jacobian_numpy`, which serves the functions without a tape) is checked
+against it in the tests.
 
 >>> from digslam.observer import Function
 >>> t = Tape.of(Function(lambda x: x[0] * x[1]))
@@ -21,8 +23,15 @@ import math
 import numpy as np
 
 from digslam.observer.core.boxes import midpoint
-from digslam.observer.core.scalar_jit import njit
-from digslam.observer.expr import tape_jit as jt
+from digslam.observer.core.scalar_jit import (
+    iadd,
+    imul,
+    ipown,
+    isub,
+    ixdiv,
+    meet,
+    njit,
+)
 from digslam.observer.expr.tape_jit import (
     ABS,
     ADD,
@@ -38,9 +47,10 @@ from digslam.observer.expr.tape_jit import (
     SUB,
     VAR,
     Tape,
+    fwd_op,
 )
 
-__all__ = ["ad_row", "centre_row", "centre_outputs", "jacobian_tape", "centred_tape"]
+__all__ = ["ad_row", "centre_outputs", "centre_row", "centred_tape", "centres", "jacobian_tape"]
 
 _INF = math.inf
 _KW = {"error_model": "numpy"}
@@ -70,38 +80,38 @@ def ad_row(code: np.ndarray, v: np.ndarray, r: int, n: int, d: np.ndarray, ok: n
         for i in range(n):
             dal, dah = d[a, i, 0], d[a, i, 1]
             if op == ADD:
-                rl, rh = jt.iadd(dal, dah, d[b, i, 0], d[b, i, 1])
+                rl, rh = iadd(dal, dah, d[b, i, 0], d[b, i, 1])
             elif op == SUB:
-                rl, rh = jt.isub(dal, dah, d[b, i, 0], d[b, i, 1])
+                rl, rh = isub(dal, dah, d[b, i, 0], d[b, i, 1])
             elif op == MUL:
-                ul, uh = jt.imul(v[0, b, r], v[1, b, r], dal, dah)
-                wl, wh = jt.imul(al, ah, d[b, i, 0], d[b, i, 1])
-                rl, rh = jt.iadd(ul, uh, wl, wh)
+                ul, uh = imul(v[0, b, r], v[1, b, r], dal, dah)
+                wl, wh = imul(al, ah, d[b, i, 0], d[b, i, 1])
+                rl, rh = iadd(ul, uh, wl, wh)
             elif op == DIV:
-                wl, wh = jt.imul(zl, zh, d[b, i, 0], d[b, i, 1])
-                ul, uh = jt.isub(dal, dah, wl, wh)
-                rl, rh = jt.ixdiv(ul, uh, v[0, b, r], v[1, b, r])
+                wl, wh = imul(zl, zh, d[b, i, 0], d[b, i, 1])
+                ul, uh = isub(dal, dah, wl, wh)
+                rl, rh = ixdiv(ul, uh, v[0, b, r], v[1, b, r])
             elif op == NEG:
                 rl, rh = -dah, -dal
             elif op == SQR:
-                cl, ch = jt.imul(2.0, 2.0, al, ah)
-                rl, rh = jt.imul(cl, ch, dal, dah)
+                cl, ch = imul(2.0, 2.0, al, ah)
+                rl, rh = imul(cl, ch, dal, dah)
             elif op == SQRT:
-                cl, ch = jt.iadd(zl, zh, zl, zh)
-                rl, rh = jt.ixdiv(dal, dah, cl, ch)
+                cl, ch = iadd(zl, zh, zl, zh)
+                rl, rh = ixdiv(dal, dah, cl, ch)
             elif op == EXP:
-                rl, rh = jt.imul(zl, zh, dal, dah)
+                rl, rh = imul(zl, zh, dal, dah)
             elif op == LOG:
-                rl, rh = jt.ixdiv(dal, dah, al, ah)
+                rl, rh = ixdiv(dal, dah, al, ah)
             elif op == ABS:
-                rl, rh = jt.imul(_sign(al), _sign(ah), dal, dah)
+                rl, rh = imul(_sign(al), _sign(ah), dal, dah)
             else:  # POWN
                 if p == 0:
                     rl, rh = 0.0, 0.0
                 else:
-                    cl, ch = jt.ipown(al, ah, p - 1)
-                    cl, ch = jt.imul(cl, ch, float(p), float(p))
-                    rl, rh = jt.imul(cl, ch, dal, dah)
+                    cl, ch = ipown(al, ah, p - 1)
+                    cl, ch = imul(cl, ch, float(p), float(p))
+                    rl, rh = imul(cl, ch, dal, dah)
             d[k, i, 0], d[k, i, 1] = rl, rh
         if op == DIV:
             valid = valid and (v[0, b, r] > 0.0 or v[1, b, r] < 0.0)
@@ -127,14 +137,14 @@ def centre_row(code: np.ndarray, cst: np.ndarray, outs: np.ndarray, lo: np.ndarr
             pv[k, 0], pv[k, 1] = cst[k, 0], cst[k, 1]
         else:
             bb = max(b, 0)
-            pv[k, 0], pv[k, 1] = jt.fwd_op(op, pv[a, 0], pv[a, 1], pv[bb, 0], pv[bb, 1], p)
+            pv[k, 0], pv[k, 1] = fwd_op(op, pv[a, 0], pv[a, 1], pv[bb, 0], pv[bb, 1], p)
     for j in range(outs.shape[0]):
         o = outs[j]
         accl, acch = pv[o, 0], pv[o, 1]
         for i in range(n):
-            xl, xh = jt.isub(lo[r, i], hi[r, i], mid[i], mid[i])
-            tl, th = jt.imul(d[o, i, 0], d[o, i, 1], xl, xh)
-            accl, acch = jt.iadd(accl, acch, tl, th)
+            xl, xh = isub(lo[r, i], hi[r, i], mid[i], mid[i])
+            tl, th = imul(d[o, i, 0], d[o, i, 1], xl, xh)
+            accl, acch = iadd(accl, acch, tl, th)
         if ok[o] and accl <= acch:
             res[j, 0], res[j, 1] = accl, acch
         else:
@@ -156,7 +166,7 @@ def centre_outputs(code: np.ndarray, cst: np.ndarray, outs: np.ndarray, lo: np.n
         centre_row(code, cst, outs, lo, hi, r, mid[r], d, ok, pv, res)
         for j in range(m):
             o = outs[j]
-            v[0, o, r], v[1, o, r] = jt.meet(v[0, o, r], v[1, o, r], res[j, 0], res[j, 1])
+            v[0, o, r], v[1, o, r] = meet(v[0, o, r], v[1, o, r], res[j, 0], res[j, 1])
 
 
 @njit(**_KW)
@@ -175,7 +185,7 @@ def _forward_rows(code: np.ndarray, cst: np.ndarray, lo: np.ndarray, hi: np.ndar
                 v[0, k, r], v[1, k, r] = cst[k, 0], cst[k, 1]
             else:
                 bb = max(b, 0)
-                v[0, k, r], v[1, k, r] = jt.fwd_op(op, v[0, a, r], v[1, a, r], v[0, bb, r], v[1, bb, r], p)
+                v[0, k, r], v[1, k, r] = fwd_op(op, v[0, a, r], v[1, a, r], v[0, bb, r], v[1, bb, r], p)
 
 
 @njit(**_KW)

@@ -18,7 +18,7 @@ import numpy as np
 
 from digslam.observer.core import arith, trig
 from digslam.observer.core import interval as _interval
-from digslam.observer.core.boxes import chunked, validate_batch
+from digslam.observer.core.boxes import chunked, empty_rows, validate_batch
 from digslam.observer.core.interval import IntervalArray
 from digslam.observer.core.types import Pair
 
@@ -146,7 +146,8 @@ class _Vars:
     """The vector argument while tracing: ``x[i]`` returns the variable node ``i``."""
 
     def __init__(self, n: int | None) -> None:
-        self.n, self.nodes = n, {}
+        self.n = n
+        self.nodes: dict[int, Expr] = {}
 
     def __getitem__(self, i: int) -> Expr:
         if not isinstance(i, (int, np.integer)) or i < 0 or (self.n is not None and i >= self.n):
@@ -268,7 +269,7 @@ class Function:
         outs = [vals[o] for o in self.outputs]
         rlo = np.stack([np.broadcast_to(o[0], lo.shape[:1]) for o in outs], axis=-1)
         rhi = np.stack([np.broadcast_to(o[1], lo.shape[:1]) for o in outs], axis=-1)
-        empty = (lo > hi).any(axis=-1)[:, None]
+        empty = empty_rows(lo, hi)[:, None]
         return np.where(empty, np.inf, rlo), np.where(empty, -np.inf, rhi)
 
     def eval(self, boxes: IntervalArray | Sequence[np.ndarray]) -> IntervalArray:

@@ -1,7 +1,7 @@
 """Compiled forward-backward (HC4-revise, thesis §2.4.1.2) and ``f⁻¹([y])`` separation on a tape.
 
 One kernel call runs a whole batch, node by node (the op dispatch is paid once per node, not per
-box): the forward pass evaluates every node of the :class:`~.jit_tape.Tape` on every box (natural
+box): the forward pass evaluates every node of the :class:`~.tape_jit.Tape` on every box (natural
 inclusion, Eq. 2.21), the outputs are intersected with ``[y]`` and the backward pass applies the
 projection rules of :mod:`.backward` (their scalar forms are here) down to the variables. A box is
 empty as soon as any node is. :func:`sep_box` gives both parts of the separator of Theorem 2.1
@@ -23,8 +23,18 @@ import math
 
 import numpy as np
 
-from digslam.observer.core.scalar_jit import njit
-from digslam.observer.expr import tape_jit as jt
+from digslam.observer.core.scalar_jit import (
+    iadd,
+    iexp,
+    ilog,
+    imul,
+    isqr,
+    isqrt,
+    isub,
+    ixdiv,
+    meet,
+    njit,
+)
 from digslam.observer.expr.centred_jit import centre_outputs, centres
 from digslam.observer.expr.tape_jit import (
     ABS,
@@ -40,6 +50,7 @@ from digslam.observer.expr.tape_jit import (
     SUB,
     VAR,
     Tape,
+    fwd_op,
 )
 
 _INF = math.inf
@@ -60,7 +71,7 @@ def _forward(code: np.ndarray, cst: np.ndarray, lo: np.ndarray, hi: np.ndarray, 
         else:
             bb = max(b, 0)
             for r in range(nb):
-                v[0, k, r], v[1, k, r] = jt.fwd_op(op, v[0, a, r], v[1, a, r], v[0, bb, r], v[1, bb, r], p)
+                v[0, k, r], v[1, k, r] = fwd_op(op, v[0, a, r], v[1, a, r], v[0, bb, r], v[1, bb, r], p)
     for r in range(nb):
         for i in range(lo.shape[1]):
             if lo[r, i] > hi[r, i]:
@@ -72,41 +83,41 @@ def _rule(op: int, zl: float, zh: float, xl: float, xh: float, yl: float, yh: fl
           p: int) -> tuple[float, float, float, float]:  # fmt: skip
     """Projection rule of :mod:`.backward` for ``z = op(x, y)``: the contracted ``x, y``."""
     if op == ADD:
-        tl, th = jt.isub(zl, zh, yl, yh)
-        xl, xh = jt.meet(xl, xh, tl, th)
-        tl, th = jt.isub(zl, zh, xl, xh)
+        tl, th = isub(zl, zh, yl, yh)
+        xl, xh = meet(xl, xh, tl, th)
+        tl, th = isub(zl, zh, xl, xh)
         return xl, xh, tl, th
     if op == SUB:
-        tl, th = jt.iadd(zl, zh, yl, yh)
-        xl, xh = jt.meet(xl, xh, tl, th)
-        tl, th = jt.isub(xl, xh, zl, zh)
+        tl, th = iadd(zl, zh, yl, yh)
+        xl, xh = meet(xl, xh, tl, th)
+        tl, th = isub(xl, xh, zl, zh)
         return xl, xh, tl, th
     if op == MUL:
         xl, xh = mul_rev(zl, zh, yl, yh, xl, xh)
         yl, yh = mul_rev(zl, zh, xl, xh, yl, yh)
         return xl, xh, yl, yh
     if op == DIV:
-        tl, th = jt.imul(zl, zh, yl, yh)
-        xl, xh = jt.meet(xl, xh, tl, th)
+        tl, th = imul(zl, zh, yl, yh)
+        xl, xh = meet(xl, xh, tl, th)
         yl, yh = mul_rev(xl, xh, zl, zh, yl, yh)
         return xl, xh, yl, yh
-    pl, ph = jt.meet(zl, zh, 0.0, _INF)
+    pl, ph = meet(zl, zh, 0.0, _INF)
     if op == NEG:
         tl, th = -zh, -zl
     elif op == SQR:
-        tl, th = jt.isqrt(zl, zh)
+        tl, th = isqrt(zl, zh)
         tl, th = symmetric(xl, xh, tl, th)
     elif op == SQRT:
-        tl, th = jt.isqr(pl, ph)
+        tl, th = isqr(pl, ph)
     elif op == EXP:
-        tl, th = jt.ilog(pl, ph)
+        tl, th = ilog(pl, ph)
     elif op == LOG:
-        tl, th = jt.iexp(zl, zh)
+        tl, th = iexp(zl, zh)
     elif op == ABS:
         tl, th = symmetric(xl, xh, pl, ph)
     else:  # POWN
         tl, th = _pown_rev(zl, zh, xl, xh, p)
-    xl, xh = jt.meet(xl, xh, tl, th)
+    xl, xh = meet(xl, xh, tl, th)
     return xl, xh, -_INF, _INF
 
 
@@ -129,7 +140,7 @@ def _backward(code: np.ndarray, w: np.ndarray, alive: np.ndarray) -> None:
                 w[0, a, r], w[1, a, r] = xl, xh
                 alive[r] = xl <= xh
                 if b >= 0:
-                    yl, yh = jt.meet(w[0, b, r], w[1, b, r], yl, yh)
+                    yl, yh = meet(w[0, b, r], w[1, b, r], yl, yh)
                     w[0, b, r], w[1, b, r] = yl, yh
                     alive[r] &= yl <= yh
 
@@ -142,8 +153,8 @@ def mul_rev(cl: float, ch: float, bl: float, bh: float, al: float, ah: float) ->
     rl, rh = _INF, -_INF
     for sl, sh in ((bl, min(bh, 0.0)), (max(bl, 0.0), bh)):
         if sl <= sh:
-            ql, qh = jt.ixdiv(cl, ch, sl, sh)
-            ql, qh = jt.meet(al, ah, ql, qh)
+            ql, qh = ixdiv(cl, ch, sl, sh)
+            ql, qh = meet(al, ah, ql, qh)
             rl, rh = min(rl, ql), max(rh, qh)
     return rl, rh
 
@@ -151,17 +162,17 @@ def mul_rev(cl: float, ch: float, bl: float, bh: float, al: float, ah: float) ->
 @njit(**_KW)
 def symmetric(xl: float, xh: float, rl: float, rh: float) -> tuple[float, float]:
     """``[x] ∩ ([r] ∪ -[r])``."""
-    pl, ph = jt.meet(xl, xh, rl, rh)
-    nl, nh = jt.meet(xl, xh, -rh, -rl)
+    pl, ph = meet(xl, xh, rl, rh)
+    nl, nh = meet(xl, xh, -rh, -rl)
     return min(pl, nl), max(ph, nh)
 
 
 @njit(**_KW)
 def root(zl: float, zh: float, n: int) -> tuple[float, float]:
     """Enclosure of ``[z]^(1/n)`` for ``[z] ⊂ [0, ∞)`` as ``exp(log(z)/n)``, as :mod:`.backward`."""
-    ll, lh = jt.ilog(zl, zh)
-    ql, qh = jt.ixdiv(ll, lh, float(n), float(n))
-    rl, rh = jt.iexp(ql, qh)
+    ll, lh = ilog(zl, zh)
+    ql, qh = ixdiv(ll, lh, float(n), float(n))
+    rl, rh = iexp(ql, qh)
     if zl <= 0.0 and zl <= zh:
         rl = 0.0
     if zh == 0.0:
@@ -175,16 +186,16 @@ def _pown_rev(zl: float, zh: float, xl: float, xh: float, n: int) -> tuple[float
     if n == 0:
         return (xl, xh) if zl <= 1.0 <= zh else (_INF, -_INF)
     if n < 0:
-        zl, zh = jt.ixdiv(1.0, 1.0, zl, zh)
+        zl, zh = ixdiv(1.0, 1.0, zl, zh)
         n = -n
-    tl, th = jt.meet(zl, zh, 0.0, _INF)
+    tl, th = meet(zl, zh, 0.0, _INF)
     pl, ph = root(tl, th, n)
     if n % 2 == 0:
         return symmetric(xl, xh, pl, ph)
-    tl, th = jt.meet(-zh, -zl, 0.0, _INF)
+    tl, th = meet(-zh, -zl, 0.0, _INF)
     ql, qh = root(tl, th, n)
-    al, ah = jt.meet(xl, xh, pl, ph)
-    bl, bh = jt.meet(xl, xh, -qh, -ql)
+    al, ah = meet(xl, xh, pl, ph)
+    bl, bh = meet(xl, xh, -qh, -ql)
     return min(al, bl), max(ah, bh)
 
 
@@ -202,7 +213,7 @@ def _contract(code: np.ndarray, outs: np.ndarray, v: np.ndarray, w: np.ndarray, 
         o = outs[j]
         for r in range(w.shape[2]):
             yl, yh = (y[0, r, j], y[1, r, j]) if per_box else (y[0, 0, j], y[1, 0, j])
-            w[0, o, r], w[1, o, r] = jt.meet(w[0, o, r], w[1, o, r], yl, yh)
+            w[0, o, r], w[1, o, r] = meet(w[0, o, r], w[1, o, r], yl, yh)
     _backward(code, w, alive)
 
 
@@ -316,7 +327,7 @@ def hc4(t: Tape, lo: np.ndarray, hi: np.ndarray, ylo: np.ndarray, yhi: np.ndarra
         centred: bool = False) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """HC4-revise of ``f(x) ∈ [y]`` on a batch; ``[y]`` is ``(m,)`` or ``(N, m)`` per box. With
     ``centred``, each output's natural enclosure is first met with the mean-value form
-    (:mod:`.jit_centred`)."""
+    (:mod:`.centred_jit`)."""
     shape = (lo.shape[0], t.outputs.shape[0])
     y = np.stack([np.broadcast_to(ylo, shape), np.broadcast_to(yhi, shape)]).astype(np.float64)
     lo, hi = _c(lo), _c(hi)

@@ -1,7 +1,8 @@
 """Online Dig-SLAM: the observer that runs step by step beside a simulator or a robot.
 
 Lives here: :mod:`.observer` (``OnlineDigSlam``, ``OnlineConfig``), :mod:`.window` (the dig map kept in a
-sliding window) and its kernels: :mod:`.dig_jit` (digging and the cone windows), :mod:`.mark_jit`
+sliding window) and its kernels: :mod:`.dig_jit` (digging, the cone windows and the named tuples the
+kernels take: ``GridFrame``, ``CellSets``, ``PoseBox``, ``StepRecord``...), :mod:`.mark_jit`
 (marking the explored zone), :mod:`.pose_jit` (pose prediction and contraction) and :mod:`.step_jit` (one
 whole filter step, q-relaxed, Sec. 6.3).
 
@@ -10,9 +11,24 @@ May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.slam` (records,
 """
 
 from .dig_jit import (
+    CellAxes,
+    CellSets,
+    GridFrame,
+    PoseBox,
+    SectorBatch,
+    StepRecord,
+    box_ok,
+    cell_size,
+    cone_window,
     dig_batch,
     dig_cells,
-    window,
+    dig_reading,
+    edge_direction,
+    in_frame,
+    prod_hi,
+    prod_lo,
+    reach_axes,
+    union,
 )
 from .mark_jit import (
     dig_and_mark,
@@ -31,6 +47,7 @@ from .pose_jit import (
     impact_bound,
     impact_bound_q,
     predict,
+    rotate,
 )
 from .step_jit import (
     filter_step,
@@ -39,28 +56,46 @@ from .step_jit import (
 from .window import (
     MARGIN,
     WindowDigMap,
+    grid_frame,
     mark_possibly_sensed,
 )
 
 __all__ = [
+    "CellAxes",
+    "CellSets",
+    "GridFrame",
     "MARGIN",
     "OnlineConfig",
     "OnlineDigSlam",
+    "PoseBox",
+    "SectorBatch",
+    "StepRecord",
     "WindowDigMap",
+    "box_ok",
+    "cell_size",
     "clearance_cells",
+    "cone_window",
     "contract",
     "cos_sin",
     "dig_and_mark",
     "dig_and_mark_q",
     "dig_batch",
     "dig_cells",
+    "dig_reading",
+    "edge_direction",
     "filter_step",
     "filter_step_q",
+    "grid_frame",
     "impact_bound",
     "impact_bound_q",
+    "in_frame",
     "mark_batch",
     "mark_cells",
     "mark_possibly_sensed",
     "predict",
-    "window",
+    "prod_hi",
+    "prod_lo",
+    "reach_axes",
+    "rotate",
+    "union",
 ]

@@ -9,20 +9,28 @@ distance rounded up) and, for a cone, inside the narrowed cone ``θ ∈ [θ₁, 
 ``{cross(e₁, p) >= 0} ∩ {cross(p, e₂) >= 0}``, bounded below on the box with interval products and ``e_k``
 enclosed by widened ``cos``/``sin``; a wider cone is covered by two cones of aperture ``π⁻``. These are
 the proofs of :meth:`.digmap.DigMap.dig_sectors` and :meth:`~.digmap.DigMap.dig_disks`; every dug cell is
-also certainly sensed. The possibly sensed zone is in :mod:`.online_jit_mark`.
+also certainly sensed. The possibly sensed zone is in :mod:`.mark_jit`.
 
 In the q-relaxed mode of the filter (at most ``q`` outliers among the readings of one step, thesis §2.6.2,
-Eq. 2.54) a reading does not dig: :func:`_dig` with a reading stamp ``sid > 0`` counts, per cell, the readings
-of the step that prove it free, and :func:`.online_jit_mark.dig_and_mark_q` digs the cells counted
+Eq. 2.54) a reading does not dig: :func:`dig_reading` with a reading stamp ``sid > 0`` counts, per cell, the
+readings of the step that prove it free, and :func:`.mark_jit.dig_and_mark_q` digs the cells counted
 ``q + 1`` times (one of them at least is an inlier).
 
 Skipping a cell never makes a false claim here (it is just not dug), so the windows are float estimates
 padded by two cells; every claim is proved cell by cell.
 
+The kernels take their inputs as named tuples (the kernel rules of :mod:`digslam.observer.core`):
+:class:`GridFrame` (the grid, built once per grid by :func:`.window.grid_frame`), :class:`CellSets` (the
+filter's cell sets), :class:`PoseBox` (one pose box and heading interval), :class:`CellAxes` (the per-row
+and per-column bounds shared by the readings of one pose box), :class:`SectorBatch` (a batch of readings,
+one pose box each) and :class:`StepRecord` (one step's record, read by the pose and marking kernels too):
+the online folder's kernels share these types.
+
+>>> from digslam.observer.online.window import grid_frame
 >>> from digslam.observer.slam.grid import Grid
 >>> g = Grid((-2.0, -2.0), (2.0, 2.0), (8, 8))
 >>> free, sure = np.zeros(g.shape, bool), np.zeros(g.shape, bool)
->>> dig_cells(free, sure, g.xs, g.ys, -g.ys, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, np.pi, 1.2, True)
+>>> dig_cells(free, sure, grid_frame(g), PoseBox(0.0, 0.0, 0.0, 0.0, 0.0, 0.0), 0.0, np.pi, 1.2, True)
 >>> free.astype(int)[3:5].tolist()            # an omni disk of radius 1.2 around the origin
 [[0, 0, 1, 1, 1, 1, 0, 0], [0, 0, 1, 1, 1, 1, 0, 0]]
 """
@@ -30,9 +38,12 @@ padded by two cells; every claim is proved cell by cell.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
+from digslam.observer.core.angles_jit import axes_in
+from digslam.observer.core.grid_jit import window
 from digslam.observer.core.rounding import PI_DOWN
 from digslam.observer.core.scalar_jit import (
     add_dn,
@@ -48,98 +59,237 @@ from digslam.observer.core.scalar_jit import (
     wup,
 )
 
-__all__ = ["dig_cells", "dig_batch", "window"]
+__all__ = [
+    "CellAxes",
+    "CellSets",
+    "GridFrame",
+    "PoseBox",
+    "SectorBatch",
+    "StepRecord",
+    "box_ok",
+    "cell_size",
+    "cone_window",
+    "dig_batch",
+    "dig_cells",
+    "dig_reading",
+    "edge_direction",
+    "in_frame",
+    "prod_hi",
+    "prod_lo",
+    "reach_axes",
+    "union",
+]
+
+
+class GridFrame(NamedTuple):
+    """The online filter's grid as its kernels read it (:func:`.window.grid_frame` builds it once per grid).
+
+    The frame is ``[xs[0], xs[-1]] × [ys[-1], ys[0]]`` and the cell size :func:`cell_size`, both exactly
+    those of the :class:`~digslam.observer.slam.grid.Grid` (whose bounds are a ``linspace`` of its frame):
+    they are not stored, so that the tuple stays small (each field costs at every call from Python).
+
+    Attributes:
+        xs: ``(nx + 1,)`` exact column bounds, increasing.
+        ys: ``(ny + 1,)`` exact row bounds, decreasing (row 0 at the top).
+        nys: ``-ys`` (increasing), for :func:`~digslam.observer.core.grid_jit.window`.
+        keep, off: the constants of the clearance lower bound ``D·keep - off`` (``keep = 1 - EDT_SLACK``,
+            ``off = diag + EDT_SLACK·span``, as in :meth:`.digmap.DigMap.clearance_lower`).
+    """
+
+    xs: np.ndarray
+    ys: np.ndarray
+    nys: np.ndarray
+    keep: float
+    off: float
+
+
+class CellSets(NamedTuple):
+    """The online filter's cell sets, updated in place by the kernels (all C-contiguous).
+
+    Attributes:
+        free: ``(ny, nx)`` bool, ``M⁻``: the cells proved free (dug, Eq. 6.21).
+        sure: ``(ny, nx)`` bool, the certainly sensed cells ``Z⁻`` (the dug cells).
+        maybe: ``(ny, nx)`` bool, the possibly sensed cells ``Z⁺`` (Eq. B.5).
+        count: ``(2, ny, nx)`` int32, zero between steps: per cell, the readings of the step that prove it
+            free and the last reading that counted it (the q-relaxed mode; ``(2, 1, 1)`` when unused).
+        listed: ``(ny·nx + 1,)`` int32, ``listed[0] = 0`` between steps: the number of cells counted in the
+            step, then their flat indices ``i·nx + j`` (q-relaxed mode; ``(1,)`` when unused).
+    """
+
+    free: np.ndarray
+    sure: np.ndarray
+    maybe: np.ndarray
+    count: np.ndarray  # type: ignore[assignment]  # a field, shadowing tuple.count
+    listed: np.ndarray
+
+
+class PoseBox(NamedTuple):
+    """One pose box: the position box ``[x]`` and the heading interval ``[ψ]`` (scalars).
+
+    Attributes:
+        x_lo, y_lo, x_hi, y_hi: the position box ``[x⁻, x⁺] × [y⁻, y⁺]``.
+        psi_lo, psi_hi: the heading interval ``[ψ⁻, ψ⁺]``.
+    """
+
+    x_lo: float
+    y_lo: float
+    x_hi: float
+    y_hi: float
+    psi_lo: float
+    psi_hi: float
+
+
+class CellAxes(NamedTuple):
+    """Bounds of the relative boxes ``c - [x]`` of the cells of a window, per column and per row
+    (:func:`reach_axes`): shared by every reading of one pose box, each cell test then only compares them.
+
+    Attributes:
+        cols: ``(4, nc)``: per column from ``col0``, the lower and upper bound of ``x_c - [x]`` (outward
+            rounded), the farthest squared distance (rounded up) and the nearest (rounded down).
+        rows: ``(4, nr)``: the same per row from ``row0``, for ``y``.
+        row0, col0: the window's first row and column.
+    """
+
+    cols: np.ndarray
+    rows: np.ndarray
+    row0: int
+    col0: int
+
+
+class SectorBatch(NamedTuple):
+    """A batch of readings, each from its own pose box (:func:`dig_batch`).
+
+    Attributes:
+        lo, hi: ``(N, 2)`` the pose boxes.
+        psi_lo, psi_hi: ``(N,)`` the heading intervals.
+        alpha, gamma: ``(N,)`` the cone directions (relative to the heading) and half-apertures.
+        r: ``(N,)`` the free ranges.
+        disk: ``(N,)`` bool: the omnidirectional sensor (the open disk; ``psi``, ``alpha``, ``gamma`` unused).
+    """
+
+    lo: np.ndarray
+    hi: np.ndarray
+    psi_lo: np.ndarray
+    psi_hi: np.ndarray
+    alpha: np.ndarray
+    gamma: np.ndarray
+    r: np.ndarray
+    disk: np.ndarray
+
+
+class StepRecord(NamedTuple):
+    """One single-step record as the filter's kernels read it: the fields of a single-step
+    :class:`~digslam.observer.slam.record.MissionRecord` and the duration of the step that ends at it.
+
+    Attributes:
+        dt: ``t_k - t_{k-1}``, the duration of the step (0 for the first record of an episode).
+        speed, lateral: ``(2,)`` the body-frame velocity ``v = (v_1, v_2)`` (forward, leftward), bounding the
+            truth over the step (``x' = R(ψ) v``, Eq. 3.59, 6.12, B.20; ``lateral = [0, 0]``: a unicycle).
+        yaw_rate: ``(2,)`` the yaw-rate interval, bounding the truth over the step.
+        heading: ``(2,)`` the compass interval at ``t_k``.
+        alpha, gamma, r_max: ``(n,)`` the cones' directions (relative to the heading), half-apertures and
+            maximum ranges.
+        ranges: ``(n, 2)`` the range intervals (``[r_max, inf]`` where ``no_echo``).
+        no_echo: ``(n,)`` bool, True where nothing lies in the cone up to ``r_max``.
+    """
+
+    dt: float
+    speed: np.ndarray
+    lateral: np.ndarray
+    yaw_rate: np.ndarray
+    heading: np.ndarray
+    alpha: np.ndarray
+    gamma: np.ndarray
+    r_max: np.ndarray
+    ranges: np.ndarray
+    no_echo: np.ndarray
 
 
 @njit(inline="always")
-def _plo(al: float, ah: float, bl: float, bh: float) -> float:
-    """Lower bound of ``[a]·[b]`` (finite): each product is within half an ulp, so one :func:`.jit.dn`
-    step of the smallest bounds them all."""
+def cell_size(grid: GridFrame) -> tuple[float, float]:
+    """The cell size ``(dx, dy)`` of ``grid``: its frame's sides over the numbers of columns and rows, which
+    is ``Grid.cell_size`` to the bit (the same two operations on the same floats)."""
+    xs, ys = grid.xs, grid.ys
+    return (xs[xs.size - 1] - xs[0]) / (xs.size - 1), (ys[0] - ys[ys.size - 1]) / (ys.size - 1)
+
+
+@njit(inline="always")
+def in_frame(grid: GridFrame, x0: float, y0: float, x1: float, y1: float) -> bool:
+    """Whether the box ``[x0, x1] × [y0, y1]`` is non-empty and lies in the frame of ``grid``."""
+    xs, ys = grid.xs, grid.ys
+    return xs[0] <= x0 <= x1 <= xs[xs.size - 1] and ys[ys.size - 1] <= y0 <= y1 <= ys[0]
+
+
+@njit(inline="always")
+def prod_lo(al: float, ah: float, bl: float, bh: float) -> float:
+    """Lower bound of ``[a]·[b]`` (finite bounds): each product is within half an ulp, so one
+    :func:`~digslam.observer.core.scalar_jit.dn` step of the smallest bounds them all."""
     return dn(min(al * bl, al * bh, ah * bl, ah * bh))
 
 
 @njit(inline="always")
-def _phi(al: float, ah: float, bl: float, bh: float) -> float:
-    """Upper bound of ``[a]·[b]`` (finite)."""
+def prod_hi(al: float, ah: float, bl: float, bh: float) -> float:
+    """Upper bound of ``[a]·[b]`` (finite bounds): one :func:`~digslam.observer.core.scalar_jit.up` step of
+    the largest product."""
     return up(max(al * bl, al * bh, ah * bl, ah * bh))
 
 
 @njit
-def _edge(t: float) -> tuple[float, float, float, float]:
-    """Enclosures ``(cos⁻, cos⁺, sin⁻, sin⁺)`` of the edge direction ``e(t)`` (libm widened)."""
+def edge_direction(t: float) -> tuple[float, float, float, float]:
+    """Enclosures ``(cos⁻, cos⁺, sin⁻, sin⁺)`` of the direction ``e(t) = (cos t, sin t)`` of a cone edge
+    (libm's values widened by ``LIBM_ULPS`` ulps)."""
     c, s = math.cos(t), math.sin(t)
     return wdn(c), wup(c), wdn(s), wup(s)
 
 
-@njit
-def _count(a: np.ndarray, v: float, strict: bool) -> int:
-    """Number of entries of the increasing ``a`` that are ``< v`` (``<= v`` unless ``strict``): bisection."""
-    lo, hi = 0, a.size
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if a[mid] < v or (not strict and a[mid] == v):
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
+@njit(inline="always")
+def box_ok(box: PoseBox) -> bool:
+    """Whether the position box of ``box`` is non-empty and finite."""
+    x0, y0, x1, y1 = box.x_lo, box.y_lo, box.x_hi, box.y_hi
+    return x0 <= x1 and y0 <= y1 and math.isfinite(x0 + y0 + x1 + y1)
 
 
 @njit
-def window(xs: np.ndarray, nys: np.ndarray, x0: float, y0: float, x1: float, y1: float
-           ) -> tuple[int, int, int, int]:  # fmt: skip
-    """Rows ``r0:r1`` and columns ``c0:c1`` of the cells meeting the closed box (``nys = -ys``)."""
-    nx, ny = xs.size - 1, nys.size - 1
-    c0 = min(max(_count(xs, x0, True) - 1, 0), nx)
-    c1 = min(max(_count(xs, x1, False), c0), nx)
-    r0 = min(max(_count(nys, -y1, True) - 1, 0), ny)
-    r1 = min(max(_count(nys, -y0, False), r0), ny)
-    return r0, r1, c0, c1
+def cone_window(grid: GridFrame, box: PoseBox, t1: float, t2: float, r: float, pad: float,
+                e1: tuple[float, float, float, float], e2: tuple[float, float, float, float]
+                ) -> tuple[int, int, int, int]:  # fmt: skip
+    """Cells meeting the bounding box of ``[x] + {ρ <= r, θ ∈ [t1, t2]}`` plus ``pad``: rows and columns
+    ``(r0, r1, c0, c1)`` (:func:`~digslam.observer.core.grid_jit.window`).
 
-
-@njit
-def _cone_window(xs: np.ndarray, nys: np.ndarray, lo0: float, lo1: float, hi0: float, hi1: float,
-                 t1: float, t2: float, r: float, pad: float, c1: float, s1: float, c2: float, s2: float
-                 ) -> tuple[int, int, int, int]:  # fmt: skip
-    """Cells meeting the bounding box of ``[x] + {ρ <= r, θ ∈ [t1, t2]}`` (``t2 - t1 <= 2π``) plus ``pad``.
-
-    The extreme points are the apex, the two edge ends ``r (c_k, s_k)`` (``cos``, ``sin`` of ``t_k`` within
-    ``10⁻¹⁵``) and the axis points ``m π/2`` inside ``[t1, t2]``; ``pad`` (two cells) covers the rounding of
-    these values and of the float multiples of ``π/2``.
+    The extreme points are the apex, the two edge ends ``r (c_k, s_k)`` (the lower ends of ``e1``, ``e2``,
+    :func:`edge_direction` of ``t1``, ``t2``: within ``10⁻¹⁵`` of ``cos``, ``sin``) and the axis points
+    ``r·(±1, 0)``, ``r·(0, ±1)`` of the directions inside ``[t1, t2]``
+    (:func:`~digslam.observer.core.angles_jit.axes_in`, which never misses one); ``pad`` (two cells) covers
+    the rounding of these values.
     """
+    c1, s1, c2, s2 = e1[0], e1[2], e2[0], e2[2]
     ax0, ax1 = min(0.0, r * c1, r * c2), max(0.0, r * c1, r * c2)
     ay0, ay1 = min(0.0, r * s1, r * s2), max(0.0, r * s1, r * s2)
-    m = math.floor(t1 / (0.5 * math.pi)) + 1.0
-    for _ in range(5):
-        if m * (0.5 * math.pi) <= t2:
-            q = int(m % 4.0)  # the axis point (1, 0), (0, 1), (-1, 0) or (0, -1)
-            if q == 0:
-                ax1 = max(ax1, r)
-            elif q == 1:
-                ay1 = max(ay1, r)
-            elif q == 2:
-                ax0 = min(ax0, -r)
-            else:
-                ay0 = min(ay0, -r)
-        m += 1.0
-    return window(xs, nys, lo0 + ax0 - pad, lo1 + ay0 - pad, hi0 + ax1 + pad, hi1 + ay1 + pad)
+    east, north, west, south = axes_in(t1, t2)
+    if east:
+        ax1 = max(ax1, r)
+    if north:
+        ay1 = max(ay1, r)
+    if west:
+        ax0 = min(ax0, -r)
+    if south:
+        ay0 = min(ay0, -r)
+    return window(grid.xs, grid.nys, box.x_lo + ax0 - pad, box.y_lo + ay0 - pad, box.x_hi + ax1 + pad,
+                  box.y_hi + ay1 + pad)  # fmt: skip
 
 
 @njit
-def _axes(xs: np.ndarray, ys: np.ndarray, lo0: float, lo1: float, hi0: float, hi1: float, r0: int, r1: int,
-          c0: int, c1: int) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """Per column ``c0:c1`` and per row ``r0:r1`` of the relative boxes ``c - [x]`` (outward rounded): the
-    lower and upper bounds, the farthest squared distance (rounded up) and the nearest (rounded down).
-
-    Shared by every reading of one pose box: each cell test then only compares these bounds.
-    """
+def _axes(grid: GridFrame, box: PoseBox, r0: int, r1: int, c0: int, c1: int) -> tuple[np.ndarray, np.ndarray]:
+    """:attr:`CellAxes.cols` of the columns ``c0:c1`` and :attr:`CellAxes.rows` of the rows ``r0:r1``."""
+    xs, ys = grid.xs, grid.ys
     ax, ay = np.empty((4, c1 - c0)), np.empty((4, r1 - r0))
     for j in range(c0, c1):
-        lo, hi = sub_dn(xs[j], hi0), sub_up(xs[j + 1], lo0)
+        lo, hi = sub_dn(xs[j], box.x_hi), sub_up(xs[j + 1], box.x_lo)
         far, near = max(-lo, hi), max(lo, -hi, 0.0)
         k = j - c0
         ax[0, k], ax[1, k], ax[2, k], ax[3, k] = lo, hi, mul_up(far, far), mul_dn(near, near)
     for i in range(r0, r1):
-        lo, hi = sub_dn(ys[i + 1], hi1), sub_up(ys[i], lo1)
+        lo, hi = sub_dn(ys[i + 1], box.y_hi), sub_up(ys[i], box.y_lo)
         far, near = max(-lo, hi), max(lo, -hi, 0.0)
         k = i - r0
         ay[0, k], ay[1, k], ay[2, k], ay[3, k] = lo, hi, mul_up(far, far), mul_dn(near, near)
@@ -147,32 +297,34 @@ def _axes(xs: np.ndarray, ys: np.ndarray, lo0: float, lo1: float, hi0: float, hi
 
 
 @njit
-def _dig_cone(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, nys: np.ndarray, lo0: float, lo1: float,
-              hi0: float, hi1: float, t1: float, t2: float, r: float, disk: bool, ax: np.ndarray,
-              ay: np.ndarray, R0: int, C0: int, cnt: np.ndarray, lst: np.ndarray, sid: int
-              ) -> tuple[int, int, int, int]:  # fmt: skip
+def _dig_cone(cells: CellSets, grid: GridFrame, box: PoseBox, t1: float, t2: float, r: float, disk: bool,
+              axes: CellAxes, sid: int) -> tuple[int, int, int, int]:  # fmt: skip
     """Dig the cells inside ``[x] + {ρ < r, θ ∈ [t1, t2]}`` (``disk``: the whole disk), ``t2 - t1 <= π``;
-    ``ax``, ``ay``: :func:`_axes` of a window from row ``R0``, column ``C0`` holding the reading's window.
-    Returns the window ``(r0, r1, c0, c1)`` of the cells it dug (empty: ``r0 >= r1``).
+    ``axes``: :func:`reach_axes` of a window holding the reading's window. Returns the window
+    ``(r0, r1, c0, c1)`` of the cells it dug (empty: ``r0 >= r1``).
 
-    ``sid = 0`` digs (sets ``free`` and ``sure``). ``sid > 0`` (the q-relaxed mode, :func:`_dig` of reading
-    ``sid - 1``) only counts: each proved cell not yet in ``M⁻`` gets ``cnt[0] += 1`` once per reading
-    (``cnt[1]`` holds the reading that counted it last, so the two halves of a wide cone count once), a cell
-    counted for the first time in the step is appended to the list ``lst`` (``lst[0]`` its length, then
-    flat indices ``i·nx + j``), and the window returned is that of the counted cells; ``cnt`` is then
-    ``(2, ny, nx)`` and ``lst`` ``(ny·nx + 1,)``, else both unused.
+    ``sid = 0`` digs (sets ``free`` and ``sure``). ``sid > 0`` (the q-relaxed mode, :func:`dig_reading` of
+    reading ``sid - 1``) only counts: each proved cell not yet in ``M⁻`` gets ``count[0] += 1`` once per
+    reading (``count[1]`` holds the reading that counted it last, so the two halves of a wide cone count
+    once), a cell counted for the first time in the step is appended to ``listed``, and the window returned
+    is that of the counted cells (:class:`CellSets`).
 
     The bounds that depend on the column only (``p_x`` terms) or on the row only (``p_y`` terms) are
     computed once; each cell then compares them. A comparison ``a ≥ b`` of two bounds is exact, and so is
     ``fl(a + b) < c`` for a float ``c`` (round-to-nearest is monotone): no rounding is lost.
     """
+    free, sure, cnt, lst = cells.free, cells.sure, cells.count, cells.listed
+    xs, nys = grid.xs, grid.nys
+    ax, ay, R0, C0 = axes.cols, axes.rows, axes.row0, axes.col0
     pad = 2.0 * max(xs[1] - xs[0], -nys[1] + nys[0])
-    c1l, c1h, s1l, s1h = _edge(t1)
-    c2l, c2h, s2l, s2h = _edge(t2)
+    e1, e2 = edge_direction(t1), edge_direction(t2)
+    c1l, c1h, s1l, s1h = e1
+    c2l, c2h, s2l, s2h = e2
     if disk:
-        r0, r1, c0, c1 = window(xs, nys, lo0 - r - pad, lo1 - r - pad, hi0 + r + pad, hi1 + r + pad)
+        r0, r1, c0, c1 = window(xs, nys, box.x_lo - r - pad, box.y_lo - r - pad, box.x_hi + r + pad,
+                                box.y_hi + r + pad)  # fmt: skip
     else:
-        r0, r1, c0, c1 = _cone_window(xs, nys, lo0, lo1, hi0, hi1, t1, t2, r, pad, c1l, s1l, c2l, s2l)
+        r0, r1, c0, c1 = cone_window(grid, box, t1, t2, r, pad, e1, e2)
     r0, r1 = max(r0, R0), min(r1, R0 + ay.shape[1])
     c0, c1 = max(c0, C0), min(c1, C0 + ax.shape[1])
     if r0 >= r1 or c0 >= c1:
@@ -184,7 +336,7 @@ def _dig_cone(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, nys: np.ndarra
     xl, xh, fx2 = ax[0, c0 - C0 : c1 - C0], ax[1, c0 - C0 : c1 - C0], ax[2, c0 - C0 : c1 - C0]
     if not disk:
         for k in range(n):
-            sx1[k], sx2[k] = _phi(s1l, s1h, xl[k], xh[k]), _plo(s2l, s2h, xl[k], xh[k])
+            sx1[k], sx2[k] = prod_hi(s1l, s1h, xl[k], xh[k]), prod_lo(s2l, s2h, xl[k], xh[k])
     for i in range(r0, r1):
         fy2 = ay[2, i - R0]
         if not fy2 < r2:
@@ -192,7 +344,7 @@ def _dig_cone(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, nys: np.ndarra
         cy1 = cy2 = 0.0
         if not disk:
             dyl, dyh = ay[0, i - R0], ay[1, i - R0]
-            cy1, cy2 = _plo(c1l, c1h, dyl, dyh), _phi(c2l, c2h, dyl, dyh)
+            cy1, cy2 = prod_lo(c1l, c1h, dyl, dyh), prod_hi(c2l, c2h, dyl, dyh)
         fr, sr = free[i, c0:c1], sure[i, c0:c1]  # row slices indexed from 0 (no wraparound checks)
         if sid:
             cc, cs = cnt[0, i, c0:c1], cnt[1, i, c0:c1]
@@ -219,29 +371,31 @@ def _dig_cone(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, nys: np.ndarra
 
 
 @njit
-def _dig(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, nys: np.ndarray, lo0: float, lo1: float,
-         hi0: float, hi1: float, psi_lo: float, psi_hi: float, alpha: float, gamma: float, r: float,
-         disk: bool, ax: np.ndarray, ay: np.ndarray, R0: int, C0: int, cnt: np.ndarray, lst: np.ndarray,
-         sid: int) -> tuple[int, int, int, int]:  # fmt: skip
-    """:func:`dig_cells` on shared :func:`_axes`; returns the window of the dug cells (:func:`_dig_cone`;
-    ``sid > 0``: only count them in ``cnt`` and ``lst``, once for the reading ``sid``, the q-relaxed
-    mode)."""
+def dig_reading(cells: CellSets, grid: GridFrame, box: PoseBox, alpha: float, gamma: float, r: float,
+                disk: bool, axes: CellAxes, sid: int) -> tuple[int, int, int, int]:  # fmt: skip
+    """Eq. 6.21 for one reading (direction ``alpha``, half-aperture ``gamma``, free range ``r``; ``disk``:
+    the open disk) from ``box``, on shared :func:`reach_axes` (their window must hold the reading's).
+
+    Digs ``cells.free`` and ``cells.sure`` (``sid = 0``), or, in the q-relaxed mode (``sid > 0``, the
+    reading's stamp), only counts the proved cells in ``cells.count`` and ``cells.listed``, once for the
+    reading. The narrowed cone is ``[θ₁, θ₂] = [ψ⁺ + α - γ, ψ⁻ + α + γ]`` rounded inwards; one wider than
+    ``π`` is covered by ``[θ₁, θ₁ + π⁻]`` and ``[θ₂ - π⁻, θ₂]``. Returns the window ``(r0, r1, c0, c1)``
+    of the cells it dug or counted (empty: ``r0 >= r1``); ``r`` not finite or ``<= 0`` and empty cones dig
+    nothing.
+    """
     if not (math.isfinite(r) and r > 0.0):
         return 0, 0, 0, 0
     if disk:
-        return _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, 0.0, 0.0, r, True, ax, ay, R0, C0, cnt,
-                         lst, sid)  # fmt: skip
-    t1, t2 = sub_up(add_up(psi_hi, alpha), gamma), add_dn(add_dn(psi_lo, alpha), gamma)
+        return _dig_cone(cells, grid, box, 0.0, 0.0, r, True, axes, sid)
+    t1, t2 = sub_up(add_up(box.psi_hi, alpha), gamma), add_dn(add_dn(box.psi_lo, alpha), gamma)
     if not (math.isfinite(t1) and math.isfinite(t2) and t1 <= t2):
         return 0, 0, 0, 0
     if sub_up(t2, t1) > PI_DOWN:  # [θ₁, θ₁ + π⁻] and [θ₂ - π⁻, θ₂], both inside [θ₁, θ₂]
         t3, t4 = add_dn(t1, PI_DOWN), sub_up(t2, PI_DOWN)
-        a = _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, t1, t3, r, False, ax, ay, R0, C0, cnt, lst,
-                      sid)  # fmt: skip
-        b = _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, t4, t2, r, False, ax, ay, R0, C0, cnt, lst,
-                      sid)  # fmt: skip
+        a = _dig_cone(cells, grid, box, t1, t3, r, False, axes, sid)
+        b = _dig_cone(cells, grid, box, t4, t2, r, False, axes, sid)
         return union(a, b)
-    return _dig_cone(free, sure, xs, nys, lo0, lo1, hi0, hi1, t1, t2, r, False, ax, ay, R0, C0, cnt, lst, sid)
+    return _dig_cone(cells, grid, box, t1, t2, r, False, axes, sid)
 
 
 @njit(inline="always")
@@ -256,42 +410,36 @@ def union(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> tuple[i
 
 
 @njit
-def _reach_axes(xs: np.ndarray, ys: np.ndarray, nys: np.ndarray, lo0: float, lo1: float, hi0: float,
-                hi1: float, r: float) -> tuple[np.ndarray, np.ndarray, int, int]:  # fmt: skip
-    """:func:`_axes` on the window of the box grown by ``r`` plus two cells (holds every reading's window
-    of range ``<= r``)."""
+def reach_axes(grid: GridFrame, box: PoseBox, r: float) -> CellAxes:
+    """:class:`CellAxes` of the window of the position box grown by ``r`` plus two cells, which holds the
+    window of every reading of range ``<= r`` from ``box``."""
+    xs, ys = grid.xs, grid.ys
     pad = 2.0 * max(xs[1] - xs[0], ys[0] - ys[1])
-    r0, r1, c0, c1 = window(xs, nys, lo0 - r - pad, lo1 - r - pad, hi0 + r + pad, hi1 + r + pad)
-    ax, ay = _axes(xs, ys, lo0, lo1, hi0, hi1, r0, r1, c0, c1)
-    return ax, ay, r0, c0
-
-
-@njit(inline="always")
-def _box_ok(lo0: float, lo1: float, hi0: float, hi1: float) -> bool:
-    return lo0 <= hi0 and lo1 <= hi1 and math.isfinite(lo0 + lo1 + hi0 + hi1)
+    r0, r1, c0, c1 = window(xs, grid.nys, box.x_lo - r - pad, box.y_lo - r - pad, box.x_hi + r + pad,
+                            box.y_hi + r + pad)  # fmt: skip
+    ax, ay = _axes(grid, box, r0, r1, c0, c1)
+    return CellAxes(ax, ay, r0, c0)
 
 
 @njit
-def dig_cells(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, ys: np.ndarray, nys: np.ndarray,
-              lo0: float, lo1: float, hi0: float, hi1: float, psi_lo: float, psi_hi: float, alpha: float,
-              gamma: float, r: float, disk: bool) -> None:  # fmt: skip
-    """Eq. 6.21 for one reading (free range ``r``) from the pose box ``[lo, hi]``, heading ``[ψ]``.
+def dig_cells(free: np.ndarray, sure: np.ndarray, grid: GridFrame, box: PoseBox, alpha: float, gamma: float,
+              r: float, disk: bool) -> None:  # fmt: skip
+    """Eq. 6.21 for one reading (free range ``r``) from the pose box ``box``.
 
-    ``disk``: the omnidirectional sensor (the open disk; ``psi``, ``alpha``, ``gamma`` unused); empty boxes,
-    ``r`` not finite or ``<= 0``, and empty narrowed cones dig nothing. ``free``, ``sure``: updated in place.
+    ``disk``: the omnidirectional sensor (the open disk; the heading, ``alpha``, ``gamma`` unused); empty
+    boxes, ``r`` not finite or ``<= 0``, and empty narrowed cones dig nothing. ``free``, ``sure``: updated
+    in place.
     """
-    if not (_box_ok(lo0, lo1, hi0, hi1) and math.isfinite(r) and r > 0.0):
+    if not (box_ok(box) and math.isfinite(r) and r > 0.0):
         return
-    ax, ay, R0, C0 = _reach_axes(xs, ys, nys, lo0, lo1, hi0, hi1, r)
-    _dig(free, sure, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha, gamma, r, disk, ax, ay, R0, C0,
-         np.zeros((2, 1, 1), np.int32), np.zeros(1, np.int32), 0)  # fmt: skip
+    cells = CellSets(free, sure, sure, np.zeros((2, 1, 1), np.int32), np.zeros(1, np.int32))
+    dig_reading(cells, grid, box, alpha, gamma, r, disk, reach_axes(grid, box, r), 0)
 
 
 @njit
-def dig_batch(free: np.ndarray, sure: np.ndarray, xs: np.ndarray, ys: np.ndarray, nys: np.ndarray,
-              lo: np.ndarray, hi: np.ndarray, psi_lo: np.ndarray, psi_hi: np.ndarray, alpha: np.ndarray,
-              gamma: np.ndarray, r: np.ndarray, disk: np.ndarray) -> None:  # fmt: skip
-    """:func:`dig_cells` for each row ``k`` of a batch (pose boxes ``(N, 2)``, the rest ``(N,)``)."""
-    for k in range(r.size):
-        dig_cells(free, sure, xs, ys, nys, lo[k, 0], lo[k, 1], hi[k, 0], hi[k, 1], psi_lo[k], psi_hi[k],
-                  alpha[k], gamma[k], r[k], disk[k])  # fmt: skip
+def dig_batch(free: np.ndarray, sure: np.ndarray, grid: GridFrame, batch: SectorBatch) -> None:
+    """:func:`dig_cells` for each reading ``k`` of ``batch``, from its own pose box."""
+    b = batch
+    for k in range(b.r.size):
+        box = PoseBox(b.lo[k, 0], b.lo[k, 1], b.hi[k, 0], b.hi[k, 1], b.psi_lo[k], b.psi_hi[k])
+        dig_cells(free, sure, grid, box, b.alpha[k], b.gamma[k], b.r[k], b.disk[k])

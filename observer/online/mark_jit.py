@@ -11,15 +11,17 @@ box of its apex, its arc ends and the axis points of its arc (shifted by the pos
 of padding dwarf the float error of that box, so a cell outside the window misses the sector. Not proved
 out means marked: a doubt never makes a cell dark.
 
-:func:`dig_and_mark` runs one step: :func:`.online_jit.dig_cells` for each reading's free range, then
+:func:`dig_and_mark` runs one step: :func:`.dig_jit.dig_reading` for each reading's free range, then
 :func:`mark_cells` for its upper range, sharing the per-row / per-column bounds of the pose box.
 :func:`dig_and_mark_q` is the same step robust to at most ``q`` outliers among the step's readings
 (§2.6.2): a cell is dug where ``q + 1`` readings prove it free, ``Z⁺`` grows with the maximum ranges.
+The readings come as a :class:`.dig_jit.StepRecord` (only its readings are read here).
 
+>>> from digslam.observer.online.window import grid_frame
 >>> from digslam.observer.slam.grid import Grid
 >>> g = Grid((-2.0, -2.0), (2.0, 2.0), (8, 8))
 >>> maybe = np.zeros(g.shape, bool)
->>> mark_cells(maybe, g.xs, g.ys, -g.ys, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, np.pi / 8, 1.2)
+>>> mark_cells(maybe, grid_frame(g), PoseBox(0.0, 0.0, 0.0, 0.0, 0.0, 0.0), 0.0, np.pi / 8, 1.2)
 >>> maybe.astype(int)[3:5].tolist()          # a cone towards +x from the origin
 [[0, 0, 0, 1, 1, 1, 1, 0], [0, 0, 0, 1, 1, 1, 1, 0]]
 """
@@ -30,40 +32,48 @@ import math
 
 import numpy as np
 
+from digslam.observer.core.grid_jit import window
 from digslam.observer.core.rounding import HALF_PI_DOWN, PI_DOWN
 from digslam.observer.core.scalar_jit import add_dn, add_up, mul_up, njit, sub_dn, sub_up
 from digslam.observer.online.dig_jit import (
-    _box_ok,
-    _cone_window,
-    _dig,
-    _edge,
-    _phi,
-    _plo,
-    _reach_axes,
+    CellAxes,
+    CellSets,
+    GridFrame,
+    PoseBox,
+    StepRecord,
+    box_ok,
+    cone_window,
+    dig_reading,
+    edge_direction,
+    prod_hi,
+    prod_lo,
+    reach_axes,
     union,
-    window,
 )
 
 __all__ = ["mark_cells", "mark_batch", "dig_and_mark", "dig_and_mark_q"]
 
 
 @njit
-def _mark(maybe: np.ndarray, xs: np.ndarray, nys: np.ndarray, lo0: float, lo1: float, hi0: float, hi1: float,
-          psi_lo: float, psi_hi: float, alpha: float, gamma: float, r: float, ax: np.ndarray, ay: np.ndarray,
-          R0: int, C0: int) -> tuple[int, int, int, int]:  # fmt: skip
-    """:func:`mark_cells` on shared :func:`_axes` (their window must hold the reading's window); returns
-    the window ``(r0, r1, c0, c1)`` of the cells it marked (empty: ``r0 >= r1``)."""
+def _mark(maybe: np.ndarray, grid: GridFrame, box: PoseBox, alpha: float, gamma: float, r: float,
+          axes: CellAxes) -> tuple[int, int, int, int]:  # fmt: skip
+    """:func:`mark_cells` on shared :func:`.dig_jit.reach_axes` (their window must hold the reading's
+    window); returns the window ``(r0, r1, c0, c1)`` of the cells it marked (empty: ``r0 >= r1``)."""
     if not (math.isfinite(r) and r > 0.0):
         return 0, 0, 0, 0
-    t1, t2 = sub_dn(add_dn(psi_lo, alpha), gamma), add_up(add_up(psi_hi, alpha), gamma)
+    xs, nys = grid.xs, grid.nys
+    ax, ay, R0, C0 = axes.cols, axes.rows, axes.row0, axes.col0
+    t1, t2 = sub_dn(add_dn(box.psi_lo, alpha), gamma), add_up(add_up(box.psi_hi, alpha), gamma)
     narrow = math.isfinite(t1) and math.isfinite(t2) and sub_up(t2, t1) <= HALF_PI_DOWN
     pad = 2.0 * max(xs[1] - xs[0], -nys[1] + nys[0])
-    c1l, c1h, s1l, s1h = _edge(t1)
-    c2l, c2h, s2l, s2h = _edge(t2)
+    e1, e2 = edge_direction(t1), edge_direction(t2)
+    c1l, c1h, s1l, s1h = e1
+    c2l, c2h, s2l, s2h = e2
     if narrow:
-        r0, r1, c0, c1 = _cone_window(xs, nys, lo0, lo1, hi0, hi1, t1, t2, r, pad, c1l, s1l, c2l, s2l)
+        r0, r1, c0, c1 = cone_window(grid, box, t1, t2, r, pad, e1, e2)
     else:
-        r0, r1, c0, c1 = window(xs, nys, lo0 - r - pad, lo1 - r - pad, hi0 + r + pad, hi1 + r + pad)
+        r0, r1, c0, c1 = window(xs, nys, box.x_lo - r - pad, box.y_lo - r - pad, box.x_hi + r + pad,
+                                box.y_hi + r + pad)  # fmt: skip
     r0, r1 = max(r0, R0), min(r1, R0 + ay.shape[1])
     c0, c1 = max(c0, C0), min(c1, C0 + ax.shape[1])
     if r0 >= r1 or c0 >= c1:
@@ -78,7 +88,7 @@ def _mark(maybe: np.ndarray, xs: np.ndarray, nys: np.ndarray, lo0: float, lo1: f
     xl, xh, mx2 = ax[0, c0 - C0 : c1 - C0], ax[1, c0 - C0 : c1 - C0], ax[3, c0 - C0 : c1 - C0]
     if narrow:
         for k in range(n):
-            sx1[k], sx2[k] = _plo(s1l, s1h, xl[k], xh[k]), _phi(s2l, s2h, xl[k], xh[k])
+            sx1[k], sx2[k] = prod_lo(s1l, s1h, xl[k], xh[k]), prod_hi(s2l, s2h, xl[k], xh[k])
             out_col[k] = (right and xh[k] < 0.0) or (left and xl[k] > 0.0)
     for i in range(r0, r1):
         dyl, dyh, my2 = ay[0, i - R0], ay[1, i - R0], ay[3, i - R0]
@@ -86,7 +96,7 @@ def _mark(maybe: np.ndarray, xs: np.ndarray, nys: np.ndarray, lo0: float, lo1: f
             continue
         cy1 = cy2 = 0.0
         if narrow:
-            cy1, cy2 = _phi(c1l, c1h, dyl, dyh), _plo(c2l, c2h, dyl, dyh)
+            cy1, cy2 = prod_hi(c1l, c1h, dyl, dyh), prod_lo(c2l, c2h, dyl, dyh)
         mr = maybe[i, c0:c1]  # a row slice indexed from 0 (no wraparound checks)
         for k in range(n):
             if mr[k] or mx2[k] + my2 > r2:  # nearest point beyond r⁺ (exact: monotone rounding)
@@ -100,46 +110,42 @@ def _mark(maybe: np.ndarray, xs: np.ndarray, nys: np.ndarray, lo0: float, lo1: f
 
 
 @njit
-def mark_cells(maybe: np.ndarray, xs: np.ndarray, ys: np.ndarray, nys: np.ndarray, lo0: float, lo1: float,
-               hi0: float, hi1: float, psi_lo: float, psi_hi: float, alpha: float, gamma: float,
-               r: float) -> None:  # fmt: skip
-    """Mark in ``maybe`` every cell not proved outside the sensed sector of one reading (range ``<= r``)."""
-    if not (_box_ok(lo0, lo1, hi0, hi1) and math.isfinite(r) and r > 0.0):
+def mark_cells(
+    maybe: np.ndarray, grid: GridFrame, box: PoseBox, alpha: float, gamma: float, r: float
+) -> None:
+    """Mark in ``maybe`` every cell not proved outside the sensed sector of one reading (direction
+    ``alpha``, half-aperture ``gamma``, range ``<= r``) from ``box``."""
+    if not (box_ok(box) and math.isfinite(r) and r > 0.0):
         return
-    ax, ay, R0, C0 = _reach_axes(xs, ys, nys, lo0, lo1, hi0, hi1, r)
-    _mark(maybe, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha, gamma, r, ax, ay, R0, C0)
+    _mark(maybe, grid, box, alpha, gamma, r, reach_axes(grid, box, r))
 
 
 @njit
-def mark_batch(maybe: np.ndarray, xs: np.ndarray, ys: np.ndarray, nys: np.ndarray, lo0: float, lo1: float,
-               hi0: float, hi1: float, psi_lo: float, psi_hi: float, alpha: np.ndarray, gamma: np.ndarray,
+def mark_batch(maybe: np.ndarray, grid: GridFrame, box: PoseBox, alpha: np.ndarray, gamma: np.ndarray,
                r: np.ndarray) -> None:  # fmt: skip
     """:func:`mark_cells` for each reading ``k`` of one pose box."""
     for k in range(r.size):
-        mark_cells(maybe, xs, ys, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha[k], gamma[k], r[k])
+        mark_cells(maybe, grid, box, alpha[k], gamma[k], r[k])
 
 
 @njit
-def dig_and_mark(free: np.ndarray, sure: np.ndarray, maybe: np.ndarray, xs: np.ndarray, ys: np.ndarray,
-                 nys: np.ndarray, lo0: float, lo1: float, hi0: float, hi1: float, psi_lo: float,
-                 psi_hi: float, alpha: np.ndarray, gamma: np.ndarray, r_max: np.ndarray, rng: np.ndarray,
-                 mark: bool) -> tuple[int, int, int, int]:  # fmt: skip
+def dig_and_mark(cells: CellSets, grid: GridFrame, box: PoseBox, step: StepRecord, mark: bool
+                 ) -> tuple[int, int, int, int]:  # fmt: skip
     """One step's readings from one pose box: dig each free range ``min(y⁻, r_max)`` (``gamma >= π⁻`` is
-    the omnidirectional disk); with ``mark``, grow ``Z⁺`` with ``min(y⁺, r_max)`` (``rng``: ``(n, 2)``).
-    The per-row and per-column bounds (:func:`_axes`) are computed once for all the readings; returns the
+    the omnidirectional disk); with ``mark``, grow ``Z⁺`` with ``min(y⁺, r_max)``. ``step``: a
+    :class:`.dig_jit.StepRecord` (its ``alpha``, ``gamma``, ``r_max`` and ``ranges``). The per-row and
+    per-column bounds (:func:`.dig_jit.reach_axes`) are computed once for all the readings; returns the
     smallest window ``(r0, r1, c0, c1)`` holding every cell changed (``(0, 0, 0, 0)`` when none).
     :func:`dig_and_mark_q` with ``q = 0``."""
-    return dig_and_mark_q(free, sure, maybe, np.zeros((2, 1, 1), np.int32), np.zeros(1, np.int32), xs, ys,
-                          nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha, gamma, r_max, rng, mark,
-                          0)  # fmt: skip
+    return dig_and_mark_q(cells, grid, box, step, mark, 0)
 
 
 @njit
-def _settle(free: np.ndarray, sure: np.ndarray, cnt: np.ndarray, lst: np.ndarray, need: int
-            ) -> tuple[int, int, int, int]:  # fmt: skip
-    """Dig (``free``, ``sure``) the cells of the list ``lst`` (every cell counted in the step) counted at
+def _settle(cells: CellSets, need: int) -> tuple[int, int, int, int]:
+    """Dig (``free``, ``sure``) the cells of ``cells.listed`` (every cell counted in the step) counted at
     least ``need`` times, then clear their counts and stamps and the list; returns the window of the dug
     cells."""
+    free, sure, cnt, lst = cells.free, cells.sure, cells.count, cells.listed
     nx = free.shape[1]
     u0, u1, v0, v1 = free.shape[0], 0, nx, 0
     for m in range(1, lst[0] + 1):
@@ -155,50 +161,45 @@ def _settle(free: np.ndarray, sure: np.ndarray, cnt: np.ndarray, lst: np.ndarray
 
 
 @njit
-def dig_and_mark_q(free: np.ndarray, sure: np.ndarray, maybe: np.ndarray, cnt: np.ndarray, lst: np.ndarray,
-                   xs: np.ndarray, ys: np.ndarray, nys: np.ndarray, lo0: float, lo1: float, hi0: float,
-                   hi1: float, psi_lo: float, psi_hi: float, alpha: np.ndarray, gamma: np.ndarray,
-                   r_max: np.ndarray, rng: np.ndarray, mark: bool, q: int
+def dig_and_mark_q(cells: CellSets, grid: GridFrame, box: PoseBox, step: StepRecord, mark: bool, q: int
                    ) -> tuple[int, int, int, int]:  # fmt: skip
     """:func:`dig_and_mark` robust to at most ``q`` outliers among the ``n`` readings of this step.
 
     ``q = 0``: every reading digs its free range (Eq. 6.21) and marks ``Z⁺`` with ``min(y⁺, r_max)``
-    (``cnt`` unused, e.g. ``(2, 1, 1)``).
+    (``cells.count`` and ``cells.listed`` unused).
 
     ``q > 0`` (thesis §2.6.2, the q-relaxed intersection, Eq. 2.54, applied to the readings of ONE step):
-    each reading's free-range proof only counts, in ``cnt[0]`` (``(2, ny, nx)`` int32, zero between calls;
-    the counted cells listed in ``lst``, ``(ny·nx + 1,)`` int32, ``lst[0] = 0`` between calls), and a cell is
-    dug (``M⁻`` and certainly sensed ``Z⁻``) only where ``q + 1`` readings of the step prove it free: one of
-    them at least is an inlier, so the cell is free and was sensed. With ``q >= n`` nothing is dug.
-    An outlier's upper range can be below the truth, so ``Z⁺`` is grown with ``r_max`` for every reading:
-    the union over all the choices of at most ``q >= 1`` outliers (a true echo is within ``r_max``).
+    each reading's free-range proof only counts, in ``cells.count`` (the counted cells listed in
+    ``cells.listed``, :class:`.dig_jit.CellSets`), and a cell is dug (``M⁻`` and certainly sensed ``Z⁻``)
+    only where ``q + 1`` readings of the step prove it free: one of them at least is an inlier, so the cell
+    is free and was sensed. With ``q >= n`` nothing is dug. An outlier's upper range can be below the truth,
+    so ``Z⁺`` is grown with ``r_max`` for every reading: the union over all the choices of at most
+    ``q >= 1`` outliers (a true echo is within ``r_max``).
     """
-    if not _box_ok(lo0, lo1, hi0, hi1):
+    if not box_ok(box):
         return 0, 0, 0, 0
+    alpha, gamma, r_max, rng = step.alpha, step.gamma, step.r_max, step.ranges
     reach = 0.0
     for k in range(alpha.size):
         rm = min(rng[k, 1], r_max[k]) if q == 0 else r_max[k]
         for r in (min(rng[k, 0], r_max[k]), rm):
             if math.isfinite(r):
                 reach = max(reach, r)
-    ax, ay, R0, C0 = _reach_axes(xs, ys, nys, lo0, lo1, hi0, hi1, reach)
+    axes = reach_axes(grid, box, reach)
     w = (0, 0, 0, 0)
     if q == 0:
         for k in range(alpha.size):
-            w = union(w, _dig(free, sure, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha[k], gamma[k],
-                              min(rng[k, 0], r_max[k]), gamma[k] >= PI_DOWN, ax, ay, R0, C0, cnt, lst,
-                              0))  # fmt: skip
+            w = union(w, dig_reading(cells, grid, box, alpha[k], gamma[k], min(rng[k, 0], r_max[k]),
+                                     gamma[k] >= PI_DOWN, axes, 0))  # fmt: skip
     elif alpha.size > q:  # with q >= n no cell can be proved by q + 1 readings
         c = (0, 0, 0, 0)
         for k in range(alpha.size):
-            c = union(c, _dig(free, sure, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha[k], gamma[k],
-                              min(rng[k, 0], r_max[k]), gamma[k] >= PI_DOWN, ax, ay, R0, C0, cnt, lst,
-                              k + 1))  # fmt: skip
+            c = union(c, dig_reading(cells, grid, box, alpha[k], gamma[k], min(rng[k, 0], r_max[k]),
+                                     gamma[k] >= PI_DOWN, axes, k + 1))  # fmt: skip
         if c[0] < c[1] and c[2] < c[3]:
-            w = union(w, _settle(free, sure, cnt, lst, q + 1))
+            w = union(w, _settle(cells, q + 1))
     if mark:
         for k in range(alpha.size):
             rm = min(rng[k, 1], r_max[k]) if q == 0 else r_max[k]
-            w = union(w, _mark(maybe, xs, nys, lo0, lo1, hi0, hi1, psi_lo, psi_hi, alpha[k], gamma[k], rm, ax,
-                               ay, R0, C0))  # fmt: skip
+            w = union(w, _mark(cells.maybe, grid, box, alpha[k], gamma[k], rm, axes))
     return w

@@ -3,20 +3,22 @@
 Each :meth:`OnlineDigSlam.update` takes the next single-step record and
 
 1. predicts ``ψ_k ∈ [ψ_{k-1}] + [dt]·[ω_k]`` (intersected with the compass) and the heading over the
-   slice, then ``x_k ∈ x_{k-1} + [dt]·[v_k] (cos, sin)([ψ] on the slice)`` (Eq. 6.23; record ``k``'s speed
-   and yaw rate bound the truth over the slice ``[t_{k-1}, t_k]`` that ends at it: the data contract of
-   :mod:`digslam.observer.slam.record`); compiled scalar outward rounding (:func:`.online_jit_pose.predict`),
-   each correctly rounded operation stepped one ulp outward, ``cos``/``sin`` widened by more than
-   :data:`~.rounding.LIBM_ULPS`;
+   slice, then ``x_k ∈ x_{k-1} + [dt]·R([ψ] on the slice)·[v_k]`` with the body-frame velocity
+   ``v = (v_1, v_2)`` = (``speed``, ``lateral``) (``x' = R(ψ) v``, Eq. 3.59, 6.12, B.20; a unicycle record,
+   ``lateral = [0, 0]``, gives Eq. 6.23's step to the bit; record ``k``'s velocity and yaw rate bound the
+   truth over the slice ``[t_{k-1}, t_k]`` that ends at it: the data contract of
+   :mod:`digslam.observer.slam.record`); compiled scalar outward rounding (:func:`.pose_jit.predict`,
+   :func:`.pose_jit.rotate`), each correctly rounded operation stepped one ulp outward, ``cos``/``sin``
+   widened by more than :data:`~.rounding.LIBM_ULPS`;
 2. contracts the box with the impacts ``dist(x_k, comp M⁻) <= y⁺`` (Eq. 6.22) on a window
-   (:func:`.online_jit_pose.contract`);
+   (:func:`.pose_jit.contract`);
 3. digs ``M⁻ := M⁻ ∪ g⁻¹_{[x_k]}(Z⁻)`` (Eq. 6.21) and grows the explored zone: certainly sensed =
    dug, possibly sensed = not proved outside every sensed sector, one compiled pass over the cells in
-   sensor reach (:func:`.online_jit_mark.dig_and_mark`);
+   sensor reach (:func:`.mark_jit.dig_and_mark`);
 4. optionally (``smoothing_window = W``) contracts the last ``W`` boxes backward,
    ``x_j &= x_{j+1} - [d_j]``, and digs again the readings of the boxes that shrank.
 
-Steps 1–3 run as one compiled call (:func:`.online_jit_step.filter_step`, the same kernels chained), and
+Steps 1–3 run as one compiled call (:func:`.step_jit.filter_step`, the same kernels chained), and
 :attr:`OnlineDigSlam.touched` grows by the smallest window holding the cells the step changed.
 
 State is a fixed set of arrays (plus a ring of ``W`` steps): memory does not grow with the episode.
@@ -38,7 +40,7 @@ readings of different steps may hold ``q`` outliers each) miss the truth; the od
   of them is an inlier, so the claim holds. With ``q >=`` the number of readings nothing is ever dug;
 * the impact contraction (Eq. 6.22) keeps the positions consistent with all but at most ``q`` echoes,
   the hull of the q-relaxed intersection: ``dist(x, comp M⁻) <=`` the ``(q + 1)``-th smallest ``y⁺``
-  (:func:`.online_jit_pose.impact_bound_q`);
+  (:func:`.pose_jit.impact_bound_q`);
 * the possibly sensed zone grows with the maximum range ``r_max`` of every reading (an outlier's ``y⁺``
   may be below the truth), so no dark cell was sensed.
 
@@ -64,15 +66,14 @@ from __future__ import annotations
 import math
 import time
 from collections import deque
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from digslam.observer.core import rounding as rnd
+from digslam.observer.core.config import Config, check, check_int, config_dataclass
+from digslam.observer.online.dig_jit import CellSets, PoseBox, StepRecord
 from digslam.observer.online.mark_jit import dig_and_mark_q
-from digslam.observer.online.pose_jit import cos_sin as _cos_sin  # noqa: F401  (re-exported: the tests use it)
-from digslam.observer.online.pose_jit import impact_bound_q
 from digslam.observer.online.step_jit import filter_step_q
 from digslam.observer.online.window import WindowDigMap
 from digslam.observer.slam.grid import Grid
@@ -84,8 +85,8 @@ __all__ = ["OnlineConfig", "OnlineDigSlam"]
 _INF = math.inf
 
 
-@dataclass(frozen=True)
-class OnlineConfig:
+@config_dataclass
+class OnlineConfig(Config):
     """Settings of :class:`OnlineDigSlam`.
 
     Attributes:
@@ -101,22 +102,21 @@ class OnlineConfig:
     q: int = 0
 
     def __post_init__(self) -> None:
-        w = self.smoothing_window
-        if not (isinstance(w, int | np.integer) and not isinstance(w, bool) and w >= 0):
-            raise ValueError(f"smoothing_window: must be an integer >= 0, got {w!r}")
-        if not isinstance(self.impacts, bool | np.bool_):
-            raise ValueError(f"impacts: must be a bool, got {self.impacts!r}")
-        if not (isinstance(self.q, int | np.integer) and not isinstance(self.q, bool) and self.q >= 0):
-            raise ValueError(f"q: must be an integer >= 0 (outliers allowed per step), got {self.q!r}")
+        check_int("smoothing_window", self.smoothing_window, 0)
+        check(isinstance(self.impacts, bool | np.bool_), "impacts", f"must be a bool, got {self.impacts!r}")
+        check_int("q", self.q, 0, " (outliers allowed per step)")
 
-    @classmethod
-    def from_dict(cls, data: Any) -> OnlineConfig:
-        """Build from a mapping; an unknown key raises ``ValueError`` naming it."""
-        unknown = sorted(set(data) - set(cls.__dataclass_fields__))
-        if unknown:
-            known = sorted(cls.__dataclass_fields__)
-            raise ValueError(f"OnlineConfig: unknown key(s) {unknown}; known: {known}")
-        return cls(**dict(data))
+
+#: The lateral velocity of a record built without one (a unicycle, the record's default); never written.
+_NO_SLIP = np.zeros(2)
+
+
+def _step_record(rec: MissionRecord, dt: float) -> StepRecord:
+    """The kernels' view of a single-step record (:class:`.dig_jit.StepRecord`): its arrays, not copied
+    (``lateral`` unset, as in a record built without ``MissionRecord.__init__``: ``[0, 0]``, a unicycle)."""
+    lat = rec.lateral if rec.lateral is not None else _NO_SLIP
+    return StepRecord(dt, rec.speed, lat, rec.yaw_rate, rec.heading, rec.alpha, rec.gamma, rec.r_max,
+                      rec.range, rec.no_echo)  # fmt: skip
 
 
 class OnlineDigSlam:
@@ -129,8 +129,10 @@ class OnlineDigSlam:
     Attributes:
         pose_lo, pose_hi: ``(2,)`` position box at the last step (``[+inf, -inf]`` once inconsistent).
         heading_lo, heading_hi: heading interval at the last step.
-        dig: the dig zone ``M⁻`` (:class:`~.online_explored.WindowDigMap`; ``dig.free`` bool ``(ny, nx)``).
+        dig: the dig zone ``M⁻`` (:class:`~.window.WindowDigMap`; ``dig.free`` bool ``(ny, nx)``).
         sensed_sure, sensed_maybe: ``(ny, nx)`` bool, certainly / possibly sensed cells.
+        cells: those sets as the kernels take them (:class:`.dig_jit.CellSets`: ``dig.free``,
+            ``sensed_sure``, ``sensed_maybe`` and the per-cell counts of the q-relaxed mode), per episode.
         consistent, inconsistent_step: False and the step index (``reset`` is step 0) once the data
             contradicted their bounds; the sets then carry no guarantee and ``update`` does nothing.
         steps: steps folded in (``reset`` counts one); last_update_seconds: wall time of the last update.
@@ -156,7 +158,10 @@ class OnlineDigSlam:
         # per-cell reading counts and stamps of the q-relaxed mode (zero between steps; unused when q = 0)
         self._cnt = np.zeros((2, *self.grid.shape) if self._q else (2, 1, 1), dtype=np.int32)
         self._lst = np.zeros(self.grid.shape[0] * self.grid.shape[1] + 1 if self._q else 1, dtype=np.int32)
-        self.consistent, self.inconsistent_step = False, None
+        #: The cell sets as the kernels read them (:class:`.dig_jit.CellSets`), built once per episode.
+        self.cells = CellSets(self.dig.free, self.sensed_sure, self.sensed_maybe, self._cnt, self._lst)
+        self.consistent = False
+        self.inconsistent_step: int | None = None
         self.steps, self.last_update_seconds = 0, 0.0
         self._prev: MissionRecord | None = None
         self._ring.clear()
@@ -197,21 +202,19 @@ class OnlineDigSlam:
         if not self.consistent:
             return
         start = time.perf_counter()
-        d, out = self.dig, np.empty(10)  # out: the new pose box, heading and displacement (fresh arrays)
-        code, r0, r1, c0, c1 = filter_step_q(d.free, self.sensed_sure, self.sensed_maybe, d.xs, d.ys, d.nys,
-                                             d.frame, self.pose_lo, self.pose_hi, self.heading_lo,
-                                             self.heading_hi, out, float(rec.t) - float(self._prev.t),
-                                             rec.yaw_rate, rec.heading, rec.speed, rec.alpha, rec.gamma,
-                                             rec.r_max, rec.range, rec.no_echo, self._impacts, self._q,
-                                             self._cnt, self._lst)  # fmt: skip
+        step = _step_record(rec, float(rec.t) - float(self._prev.t))
+        # the kernel overwrites copies of the state: the arrays handed out are never changed
+        lo, hi, psi = self.pose_lo.copy(), self.pose_hi.copy(), np.array((self.heading_lo, self.heading_hi))
+        code, r0, r1, c0, c1, d = filter_step_q(self.cells, self.dig.frame, step, lo, hi, psi, self._impacts,
+                                                self._q)  # fmt: skip
         if code:
             return self._fail(start)
-        self.pose_lo, self.pose_hi = out[0:2], out[2:4]
-        self.heading_lo, self.heading_hi = float(out[4]), float(out[5])
+        self.pose_lo, self.pose_hi = lo, hi
+        self.heading_lo, self.heading_hi = float(psi[0]), float(psi[1])
         self._touch(r0, r1, c0, c1)
         if self.config.smoothing_window:
-            psi = (self.heading_lo, self.heading_hi)
-            self._ring.append([rec, self.pose_lo.copy(), self.pose_hi.copy(), psi, out[6:10]])
+            band = (self.heading_lo, self.heading_hi)
+            self._ring.append([step, self.pose_lo.copy(), self.pose_hi.copy(), band, d])
         self._prev = rec
         self.steps += 1
         if self.config.smoothing_window and not self._smooth():
@@ -220,11 +223,6 @@ class OnlineDigSlam:
         return None
 
     # ------------------------------------------------------------------ internals
-    def _impact_bound(self, rec: MissionRecord) -> float:
-        """Radius of the impact constraint (Eq. 6.22): the ``(q + 1)``-th smallest upper range bound over the
-        echoing sensors (the smallest when ``q = 0``; ``inf`` if fewer echoed), :func:`.impact_bound_q`."""
-        return impact_bound_q(rec.no_echo, rec.range, self._q)
-
     def _fail(self, start: float) -> None:
         self.consistent, self.inconsistent_step = False, self.steps
         self.pose_lo, self.pose_hi = np.full(2, _INF), np.full(2, -_INF)
@@ -232,15 +230,13 @@ class OnlineDigSlam:
         self.steps += 1
         self.last_update_seconds = time.perf_counter() - start
 
-    def _dig(self, rec: MissionRecord, lo: np.ndarray, hi: np.ndarray, psi: tuple[float, float],
+    def _dig(self, step: StepRecord, lo: np.ndarray, hi: np.ndarray, psi: tuple[float, float],
              mark: bool = False) -> None:  # fmt: skip
         """Eq. 6.21 for the readings of one step (the dug cells are certainly sensed: radius ``<= r_max``;
         with ``q > 0`` only the cells proved free by ``q + 1`` of them); with ``mark``, grow the possibly
         sensed zone with the upper ranges (``q > 0``: the maximum ranges), :func:`.dig_and_mark_q`."""
-        d, q = self.dig, self._q
-        r0, r1, c0, c1 = dig_and_mark_q(d.free, self.sensed_sure, self.sensed_maybe, self._cnt, self._lst,
-                                        d.xs, d.ys, d.nys, lo[0], lo[1], hi[0], hi[1], psi[0], psi[1],
-                                        rec.alpha, rec.gamma, rec.r_max, rec.range, mark, q)  # fmt: skip
+        box = PoseBox(float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]), float(psi[0]), float(psi[1]))
+        r0, r1, c0, c1 = dig_and_mark_q(self.cells, self.dig.frame, box, step, mark, self._q)
         self._touch(r0, r1, c0, c1)
 
     def _touch(self, r0: int, r1: int, c0: int, c1: int) -> None:
@@ -252,12 +248,12 @@ class OnlineDigSlam:
             else:
                 self.touched = (min(t0, r0), max(t1, r1), min(u0, c0), max(u1, c1))
 
-    def _measure(self, rec: MissionRecord, d: np.ndarray | None) -> None:
-        """Dig the readings of the current step and grow the possibly sensed zone; push the step."""
-        psi = (self.heading_lo, self.heading_hi)
-        self._dig(rec, self.pose_lo, self.pose_hi, psi, mark=True)
+    def _measure(self, rec: MissionRecord, d: tuple[float, float, float, float] | None) -> None:
+        """Dig the readings of the first step and grow the possibly sensed zone; push the step."""
+        psi, step = (self.heading_lo, self.heading_hi), _step_record(rec, 0.0)
+        self._dig(step, self.pose_lo, self.pose_hi, psi, mark=True)
         if self.config.smoothing_window:
-            self._ring.append([rec, self.pose_lo.copy(), self.pose_hi.copy(), psi, d])
+            self._ring.append([step, self.pose_lo.copy(), self.pose_hi.copy(), psi, d])
         self._prev = rec
         self.steps += 1
 
@@ -266,7 +262,7 @@ class OnlineDigSlam:
         ring = list(self._ring)
         for j in range(len(ring) - 2, -1, -1):
             _, lo, hi, psi, _ = ring[j]
-            d = ring[j + 1][4]
+            d = np.array(ring[j + 1][4])  # the displacement box (d_x⁻, d_y⁻, d_x⁺, d_y⁺) of step j + 1
             nlo = np.maximum(lo, rnd.step_down(ring[j + 1][1] - d[2:]))
             nhi = np.minimum(hi, rnd.step_up(ring[j + 1][2] - d[:2]))
             if not np.all(nlo <= nhi):

@@ -3,8 +3,10 @@ contractor on the cells of one pose box (Eq. 6.22), outward rounded with :mod:`.
 
 * :func:`predict` is one step of the tube: ``ψ_k ∈ ([ψ_{k-1}] + [dt]·[ω_k]) ∩ [compass]``, the heading over
   the slice ``[t_{k-1}, t_k]`` (both ends reachable, the gyro bounding the drift), and
-  ``x_k ∈ x_{k-1} + [dt]·[v_k]·(cos, sin)([ψ] on the slice)``; every correctly rounded operation is
-  stepped one ulp outward, ``cos``/``sin`` enclosed by :func:`cos_sin`.
+  ``x_k ∈ x_{k-1} + [dt]·R([ψ] on the slice)·[v_k]`` with the body-frame velocity ``v = (v_1, v_2)``
+  (``x' = R(ψ) v``, Eq. 3.59, 6.12, B.20; the unicycle of Eq. 6.23 is ``v_2 = 0``): :func:`rotate` encloses
+  ``R([ψ]) [v]``; every correctly rounded operation is stepped one ulp outward, ``cos``/``sin`` enclosed
+  by :func:`cos_sin`.
 * :func:`impact_bound_q` is the radius of the impact constraint, q-relaxed (§2.6.2) when the filter allows
   ``q`` outliers per step: the ``(q + 1)``-th smallest upper range.
 * :func:`clearance_cells` bounds ``dist(p, comp M⁻)`` from below for the cells of a pose box: the centre
@@ -23,11 +25,12 @@ import math
 
 import numpy as np
 
-from digslam.observer.core.rounding import HALF_PI_DOWN, HALF_PI_UP
-from digslam.observer.core.scalar_jit import dn, njit, up
-from digslam.observer.online.dig_jit import window
+from digslam.observer.core.angles_jit import axes_in
+from digslam.observer.core.grid_jit import window
+from digslam.observer.core.scalar_jit import dn, iadd, imul, isub, njit, up
+from digslam.observer.online.dig_jit import GridFrame, PoseBox, StepRecord, cell_size, prod_hi, prod_lo
 
-__all__ = ["cos_sin", "predict", "clearance_cells", "contract", "impact_bound", "impact_bound_q"]
+__all__ = ["cos_sin", "rotate", "predict", "clearance_cells", "contract", "impact_bound", "impact_bound_q"]
 
 #: Absolute widening of a libm ``cos``/``sin`` value (``|v| <= 1``): 4 ulps of 1 plus the subtraction's.
 TRIG_PAD = 2e-15
@@ -35,85 +38,106 @@ TRIG_PAD = 2e-15
 
 @njit(inline="always")
 def _mul(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
-    """Outward-rounded product of two finite intervals."""
-    p, q, r, s = al * bl, al * bh, ah * bl, ah * bh
-    return dn(min(p, q, r, s)), up(max(p, q, r, s))
+    """Outward-rounded product of two finite intervals (:func:`.dig_jit.prod_lo`,
+    :func:`.dig_jit.prod_hi`)."""
+    return prod_lo(al, ah, bl, bh), prod_hi(al, ah, bl, bh)
 
 
 @njit
 def cos_sin(a: float, b: float) -> tuple[float, float, float, float]:
-    """Enclosures ``(cos⁻, cos⁺, sin⁻, sin⁺)`` over ``[a, b]``: endpoints widened, plus every extremum
-    ``m·π/2`` that may lie in ``[a, b]`` (slack on the float multiple of ``π/2``)."""
+    """Enclosures ``(cos⁻, cos⁺, sin⁻, sin⁺)`` over ``[a, b]``: the endpoints' values widened by
+    :data:`TRIG_PAD`, and ``±1`` where an extremum ``m·π/2`` may lie in ``[a, b]``
+    (:func:`~digslam.observer.core.angles_jit.axes_in`, which never misses one); ``[-1, 1]`` twice when an
+    end is not finite."""
     if not (math.isfinite(a) and math.isfinite(b)):
         return -1.0, 1.0, -1.0, 1.0
-    f0, f1 = math.floor(a / HALF_PI_UP) - 1.0, math.floor(b / HALF_PI_DOWN) + 1.0
-    if f1 - f0 > 8.0:
+    east, north, west, south = axes_in(a, b)
+    if east and north and west and south:  # a full turn (or more)
         return -1.0, 1.0, -1.0, 1.0
     ca, cb, sa, sb = math.cos(a), math.cos(b), math.sin(a), math.sin(b)
     c0, c1 = min(ca, cb) - TRIG_PAD, max(ca, cb) + TRIG_PAD
     s0, s1 = min(sa, sb) - TRIG_PAD, max(sa, sb) + TRIG_PAD
-    for m in range(int(f0), int(f1) + 1):
-        p = m * HALF_PI_DOWN
-        eps = abs(p) * 1e-15 + 1e-300
-        if a - eps <= p <= b + eps:
-            q = m % 4
-            if q == 0:
-                c1 = 1.0
-            elif q == 1:
-                s1 = 1.0
-            elif q == 2:
-                c0 = -1.0
-            else:
-                s0 = -1.0
+    if east:
+        c1 = 1.0
+    if north:
+        s1 = 1.0
+    if west:
+        c0 = -1.0
+    if south:
+        s0 = -1.0
     return max(c0, -1.0), min(c1, 1.0), max(s0, -1.0), min(s1, 1.0)
 
 
 @njit
-def predict(
-    lo0: float,
-    lo1: float,
-    hi0: float,
-    hi1: float,
-    h0l: float,
-    h0h: float,
-    dt: float,
-    yaw_lo: float,
-    yaw_hi: float,
-    comp_lo: float,
-    comp_hi: float,
-    v_lo: float,
-    v_hi: float,
-) -> tuple[bool, float, float, float, float, float, float, float, float, float, float]:  # noqa: E501
-    """One tube step (Eq. 6.23, heading fused with the compass, Eq. 6.12).
+def rotate(v1l: float, v1h: float, v2l: float, v2h: float, cl: float, ch: float, sl: float, sh: float
+           ) -> tuple[float, float, float, float]:  # fmt: skip
+    """Enclosure ``(u_1⁻, u_1⁺, u_2⁻, u_2⁺)`` of ``{R(ψ) v : v ∈ [v_1] × [v_2], cos ψ ∈ [c], sin ψ ∈ [s]}``,
+    ``R(ψ) v = (v_1 cos ψ - v_2 sin ψ, v_1 sin ψ + v_2 cos ψ)`` (Eq. 3.59, 6.12, B.20), with
+    ``[c] = [cl, ch]``, ``[s] = [sl, sh]`` (:func:`cos_sin` of a heading interval).
 
-    Returns ``(ok, ψ⁻, ψ⁺, x⁻, y⁻, x⁺, y⁺, d_x⁻, d_y⁻, d_x⁺, d_y⁺)`` with ``d`` the displacement box;
-    ``ok`` False when the heading or its slice is empty (the data contradict their bounds).
+    Natural interval form, outward rounded: each product is the 4-corner min/max rule (the forward terms
+    by :func:`_mul`, the lateral ones by :func:`~digslam.observer.core.scalar_jit.imul`, which also takes
+    ``0·∞ = 0``), each sum TwoSum-tight (:func:`~digslam.observer.core.scalar_jit.isub`,
+    :func:`~digslam.observer.core.scalar_jit.iadd`: exact sums stay exact, others step one ulp outward).
+    ``[v_2] = [0, 0]`` (a unicycle) returns the forward terms ``[v_1]·[c]``, ``[v_1]·[s]`` as they are, the
+    unicycle step of Eq. 6.23 to the bit (``- [0, 0]·[s]`` is exactly zero).
     """
-    dtl, dth = dn(dt), up(dt)
-    wl, wh = _mul(dtl, dth, yaw_lo, yaw_hi)
-    hl, hh = max(comp_lo, dn(h0l + wl)), min(comp_hi, up(h0h + wh))
-    zl, zh = min(wl, 0.0), max(wh, 0.0)
-    sl, sh = max(dn(h0l + zl), dn(hl - zh)), min(up(h0h + zh), up(hh - zl))
-    nan = math.nan
-    if not (hl <= hh and sl <= sh):
-        return False, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan
-    cl, ch, snl, snh = cos_sin(sl, sh)
-    a, b = _mul(v_lo, v_hi, cl, ch)
-    d0l, d0h = _mul(dtl, dth, a, b)
-    a, b = _mul(v_lo, v_hi, snl, snh)
-    d1l, d1h = _mul(dtl, dth, a, b)
-    return True, hl, hh, dn(lo0 + d0l), dn(lo1 + d1l), up(hi0 + d0h), up(hi1 + d1h), d0l, d1l, d0h, d1h
+    a0l, a0h = _mul(v1l, v1h, cl, ch)
+    a1l, a1h = _mul(v1l, v1h, sl, sh)
+    if v2l == 0.0 and v2h == 0.0:
+        return a0l, a0h, a1l, a1h
+    b0l, b0h = imul(v2l, v2h, sl, sh)
+    b1l, b1h = imul(v2l, v2h, cl, ch)
+    u0l, u0h = isub(a0l, a0h, b0l, b0h)
+    u1l, u1h = iadd(a1l, a1h, b1l, b1h)
+    return u0l, u0h, u1l, u1h
 
 
 @njit
-def clearance_cells(free: np.ndarray, b0: int, b1: int, a0: int, a1: int, w0: int, w1: int, v0: int, v1: int,
-                    dx: float, dy: float, keep: float, off: float) -> np.ndarray:  # fmt: skip
-    """Lower bounds ``(b1 - b0, a1 - a0)`` on ``dist(p, comp M⁻)`` for the cells ``[b0:b1, a0:a1]``, taking
-    the cells of ``comp M⁻`` from the window ``[w0:w1, v0:v1]`` (which holds them) and its ring.
+def predict(prior: PoseBox, step: StepRecord
+            ) -> tuple[bool, PoseBox, tuple[float, float, float, float]]:  # fmt: skip
+    """One tube step from ``prior`` (``x' = R(ψ) v``, Eq. 3.59, 6.12, B.20; heading fused with the compass)
+    with the odometry of ``step`` (its ``dt``, ``yaw_rate``, ``heading``, ``speed`` and ``lateral``):
+    ``x_k ∈ x_{k-1} + [dt]·R([ψ])·[v]`` with ``[ψ]`` the heading over the whole slice and
+    ``[v] = ([speed], [lateral])`` (:func:`rotate`); a unicycle step (``lateral = [0, 0]``) is Eq. 6.23's.
 
-    ``keep = 1 - EDT_SLACK`` and ``off = diag + EDT_SLACK·span`` as in :meth:`.digmap.DigMap.clearance_lower`.
+    Returns ``(ok, box, d)``: the predicted pose box (position and heading) and the displacement box
+    ``d = (d_x⁻, d_y⁻, d_x⁺, d_y⁺)`` of the step; ``ok`` False (and NaNs) when the heading or its slice is
+    empty (the data contradict their bounds).
     """
-    rows, cols, n = _not_free(free, w0, w1, v0, v1)
+    dt, yaw, comp, v, lat = step.dt, step.yaw_rate, step.heading, step.speed, step.lateral
+    dtl, dth = dn(dt), up(dt)
+    wl, wh = _mul(dtl, dth, yaw[0], yaw[1])
+    hl, hh = max(comp[0], dn(prior.psi_lo + wl)), min(comp[1], up(prior.psi_hi + wh))
+    zl, zh = min(wl, 0.0), max(wh, 0.0)
+    sl, sh = max(dn(prior.psi_lo + zl), dn(hl - zh)), min(up(prior.psi_hi + zh), up(hh - zl))
+    nan = math.nan
+    if not (hl <= hh and sl <= sh):
+        return False, PoseBox(nan, nan, nan, nan, nan, nan), (nan, nan, nan, nan)
+    cl, ch, snl, snh = cos_sin(sl, sh)
+    u0l, u0h, u1l, u1h = rotate(v[0], v[1], lat[0], lat[1], cl, ch, snl, snh)
+    d0l, d0h = _mul(dtl, dth, u0l, u0h)
+    d1l, d1h = _mul(dtl, dth, u1l, u1h)
+    box = PoseBox(
+        dn(prior.x_lo + d0l), dn(prior.y_lo + d1l), up(prior.x_hi + d0h), up(prior.y_hi + d1h), hl, hh
+    )
+    return True, box, (d0l, d1l, d0h, d1h)
+
+
+@njit
+def clearance_cells(free: np.ndarray, grid: GridFrame, block: tuple[int, int, int, int],
+                    win: tuple[int, int, int, int]) -> np.ndarray:  # fmt: skip
+    """Lower bounds on ``dist(p, comp M⁻)`` for the cells ``block = (b0, b1, a0, a1)`` (rows ``b0:b1``,
+    columns ``a0:a1``, the result's shape), taking the cells of ``comp M⁻`` from the window
+    ``win = (w0, w1, v0, v1)`` (which holds them) and its ring.
+
+    The bound is ``D·keep - off`` with ``D`` the centre distance to the nearest not-free cell and the
+    constants of ``grid`` (:class:`.dig_jit.GridFrame`), as in :meth:`.digmap.DigMap.clearance_lower`.
+    """
+    b0, b1, a0, a1 = block
+    w0, w1, v0, v1 = win
+    (dx, dy), keep, off = cell_size(grid), grid.keep, grid.off
+    rows, cols, n = _not_free(free, win)
     out = np.zeros((b1 - b0, a1 - a0))
     for i in range(b0, b1):
         pr = i - w0
@@ -132,8 +156,9 @@ def clearance_cells(free: np.ndarray, b0: int, b1: int, a0: int, a1: int, w0: in
 
 
 @njit
-def _not_free(free: np.ndarray, w0: int, w1: int, v0: int, v1: int) -> tuple[np.ndarray, np.ndarray, int]:
-    """Rows and columns (relative to the window) of the cells of ``[w0:w1, v0:v1]`` not in ``M⁻``."""
+def _not_free(free: np.ndarray, win: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray, int]:
+    """Rows and columns (relative to the window ``win``) of the cells of ``win`` not in ``M⁻``."""
+    w0, w1, v0, v1 = win
     n = 0
     rows, cols = np.empty((w1 - w0) * (v1 - v0), np.int64), np.empty((w1 - w0) * (v1 - v0), np.int64)
     for i in range(w0, w1):
@@ -145,9 +170,10 @@ def _not_free(free: np.ndarray, w0: int, w1: int, v0: int, v1: int) -> tuple[np.
 
 
 @njit
-def _feasible(free: np.ndarray, i: int, j: int, r_hi: float, w0: int, w1: int, v0: int, v1: int, dx: float,
+def _feasible(free: np.ndarray, i: int, j: int, r_hi: float, win: tuple[int, int, int, int], dx: float,
               dy: float, keep: float, off: float) -> bool:  # fmt: skip
-    """Whether cell ``(i, j)`` may hold a pose: its :func:`clearance_cells` bound is ``<= r⁺``.
+    """Whether cell ``(i, j)`` may hold a pose: its :func:`clearance_cells` bound (on the window ``win``,
+    cell size ``dx``, ``dy``, constants ``keep``, ``off`` of :class:`.dig_jit.GridFrame`) is ``<= r⁺``.
 
     The bound is monotone in the distance, so the cell is feasible iff the ring or one not-free cell of the
     window is near enough; only the cells within the generous radius ``(r⁺ + off) / keep · (1 + 10⁻⁹)`` of
@@ -155,6 +181,7 @@ def _feasible(free: np.ndarray, i: int, j: int, r_hi: float, w0: int, w1: int, v
     """
     if not free[i, j]:
         return True
+    w0, w1, v0, v1 = win
     pr, pc = i - w0, j - v0
     ring = min(min(pr + 1, w1 - w0 - pr) * dy, min(pc + 1, v1 - v0 - pc) * dx)
     if max(dn(ring * keep - off), 0.0) <= r_hi:
@@ -177,25 +204,26 @@ def _feasible(free: np.ndarray, i: int, j: int, r_hi: float, w0: int, w1: int, v
 
 
 @njit
-def contract(free: np.ndarray, xs: np.ndarray, ys: np.ndarray, nys: np.ndarray, lo0: float, lo1: float,
-             hi0: float, hi1: float, r_hi: float, dx: float, dy: float, keep: float, off: float
+def contract(free: np.ndarray, grid: GridFrame, x0: float, y0: float, x1: float, y1: float, r_hi: float
              ) -> tuple[float, float, float, float]:  # fmt: skip
-    """Eq. 6.22 on the cells of the box ``[lo, hi]``: the box cut to the hull of the cells with clearance
-    ``<= r⁺`` (:func:`_feasible` on the window ``[x] ± (r⁺ + 2 cells)``; exact cell bounds);
-    ``(inf, inf, -inf, -inf)`` when none is."""
-    b0, b1, a0, a1 = window(xs, nys, lo0, lo1, hi0, hi1)
+    """Eq. 6.22 on the cells of the position box ``[x0, x1] × [y0, y1]``: the box cut to the hull of the
+    cells with clearance ``<= r⁺`` (:func:`_feasible` on the window ``[x] ± (r⁺ + 2 cells)``; exact cell
+    bounds); ``(inf, inf, -inf, -inf)`` when none is."""
+    xs, ys, nys = grid.xs, grid.ys, grid.nys
+    b0, b1, a0, a1 = window(xs, nys, x0, y0, x1, y1)
+    dx, dy = cell_size(grid)
     reach = r_hi + 2.0 * max(dx, dy)
-    w0, w1, v0, v1 = window(xs, nys, lo0 - reach, lo1 - reach, hi0 + reach, hi1 + reach)
+    win = window(xs, nys, x0 - reach, y0 - reach, x1 + reach, y1 + reach)
     rmin, rmax, cmin, cmax = b1, -1, a1, -1
     for i in range(b0, b1):
         for j in range(a0, a1):
-            if _feasible(free, i, j, r_hi, w0, w1, v0, v1, dx, dy, keep, off):
+            if _feasible(free, i, j, r_hi, win, dx, dy, grid.keep, grid.off):
                 rmin, rmax = min(rmin, i - b0), max(rmax, i - b0)
                 cmin, cmax = min(cmin, j - a0), max(cmax, j - a0)
     if rmax < 0:
         return math.inf, math.inf, -math.inf, -math.inf
-    return (max(lo0, xs[a0 + cmin]), max(lo1, ys[b0 + rmax + 1]), min(hi0, xs[a0 + cmax + 1]),
-            min(hi1, ys[b0 + rmin]))  # fmt: skip
+    return (max(x0, xs[a0 + cmin]), max(y0, ys[b0 + rmax + 1]), min(x1, xs[a0 + cmax + 1]),
+            min(y1, ys[b0 + rmin]))  # fmt: skip
 
 
 @njit

@@ -2,24 +2,24 @@
 
 Each step of the online filter only touches the cells within sensor reach of the current pose box.
 :class:`WindowDigMap` is a :class:`~.digmap.DigMap` whose digging runs the compiled cell kernels of
-:mod:`.online_jit` on the window of each reading (the same proofs as :meth:`DigMap.dig_disks` and
+:mod:`.dig_jit` on the window of each reading (the same proofs as :meth:`DigMap.dig_disks` and
 :meth:`DigMap.dig_sectors`, outward rounded), with a clearance lower bound computed on a window
 (:meth:`WindowDigMap.clearance_window`: cells outside the window count as *not* free, which only lowers
 distances, so the bound stays a lower bound; for the few cells of a pose box,
 :meth:`WindowDigMap.clearance_cells` takes the same minimum directly, compiled) and the impact contractor of
-Eq. 6.22 for one pose box (:meth:`WindowDigMap.contract_box`, :func:`.online_jit_pose.contract`).
+Eq. 6.22 for one pose box (:meth:`WindowDigMap.contract_box`, :func:`.pose_jit.contract`).
 
 :func:`mark_possibly_sensed` grows the outer explored zone ``Z⁺`` (Eq. B.5): a cell is marked unless it is
 *proved* to miss every sensed sector ``x + R(ψ)·{ρ <= r⁺, |θ - α| <= γ}`` for ``x ∈ [x]``, ``ψ ∈ [ψ]``:
 either its relative box ``c - [x]`` (outward rounded) misses the closed disk ``ρ <= r⁺``, or, for a cone of
 aperture at most ``π/2``, it lies strictly on the outer side of one of the cone's edges, or of an axis
-that bounds the cone (:func:`.online_jit.mark_cells`). The certainly sensed cells (``Z⁻``) are exactly the
+that bounds the cone (:func:`.dig_jit.mark_cells`). The certainly sensed cells (``Z⁻``) are exactly the
 dug cells: a cell is dug when it lies in ``x + Z⁻`` for every pose.
 
 Rounding: every bound goes through the outward-rounded scalar kernels of :mod:`.jit` (one-ulp steps of each
 correctly rounded operation, libm ``cos``/``sin`` widened by ``LIBM_ULPS`` ulps). The previous numpy
 kernels (round-to-nearest tests against the relative margin :data:`MARGIN`) are kept as test oracles in
-``tests/test_online_jit.py``.
+``tests/observer/online/test_kernels.py``.
 
 >>> g = Grid((-2.0, -2.0), (2.0, 2.0), (8, 8))
 >>> maybe = np.zeros(g.shape, bool)
@@ -38,14 +38,13 @@ import numpy as np
 from scipy.ndimage import distance_transform_edt
 
 from digslam.observer.core import rounding as rnd
-from digslam.observer.online.dig_jit import dig_batch
+from digslam.observer.online import pose_jit
+from digslam.observer.online.dig_jit import GridFrame, PoseBox, SectorBatch, dig_batch
 from digslam.observer.online.mark_jit import mark_batch
-from digslam.observer.online.pose_jit import clearance_cells as _clearance_cells
-from digslam.observer.online.pose_jit import contract as _contract
 from digslam.observer.slam.digmap import EDT_SLACK, DigMap
 from digslam.observer.slam.grid import Grid
 
-__all__ = ["WindowDigMap", "mark_possibly_sensed", "MARGIN"]
+__all__ = ["WindowDigMap", "grid_frame", "mark_possibly_sensed", "MARGIN"]
 
 #: Relative margin of the former round-to-nearest pair tests (now only used by the test oracles).
 MARGIN = 1e-13
@@ -59,21 +58,30 @@ def _slack(grid: Grid) -> tuple[float, float]:
     return 1 - EDT_SLACK, diag + EDT_SLACK * span
 
 
+def grid_frame(grid: Grid) -> GridFrame:
+    """The :class:`.dig_jit.GridFrame` of ``grid`` for the online kernels: writeable float64 copies of its
+    exact cell bounds (``xs``, ``ys``, ``nys = -ys``) and the constants ``keep = 1 - EDT_SLACK``,
+    ``off = diag + EDT_SLACK·span`` of the clearance bound."""
+    xs, ys = (np.array(v, dtype=np.float64) for v in (grid.xs, grid.ys))
+    keep, off = _slack(grid)
+    return GridFrame(xs, ys, -ys, float(keep), float(off))
+
+
 class WindowDigMap(DigMap):
     """A :class:`DigMap` whose per-step operations stay inside a window of the grid.
 
     Digging tests only the cells of each reading's window not already dug, with the compiled kernels of
-    :mod:`.online_jit` (the same claims as :meth:`DigMap.dig_sectors`: every point of the cell lies in the
+    :mod:`.dig_jit` (the same claims as :meth:`DigMap.dig_sectors`: every point of the cell lies in the
     cone, strictly inside the open disk, for every pose of the box).
     """
 
     def __init__(self, grid: Grid) -> None:
         super().__init__(grid)
         self._xs, self._nys = grid.xs.tolist(), (-grid.ys).tolist()
-        self.xs, self.ys, self.nys = (np.array(v, dtype=np.float64) for v in (grid.xs, grid.ys, -grid.ys))
-        self.keep, self.off = _slack(grid)
-        #: ``(gx⁻, gy⁻, gx⁺, gy⁺, dx, dy, keep, off)`` for :func:`.online_jit_step.filter_step`.
-        self.frame = np.array([*grid.lo, *grid.hi, *grid.cell_size, self.keep, self.off], dtype=np.float64)
+        #: The grid as the online kernels read it (:func:`grid_frame`, :class:`.dig_jit.GridFrame`).
+        self.frame = grid_frame(grid)
+        self.xs, self.ys, self.nys = self.frame.xs, self.frame.ys, self.frame.nys
+        self.keep, self.off = self.frame.keep, self.frame.off
 
     def win(self, lo: np.ndarray, hi: np.ndarray) -> tuple[int, int, int, int]:
         """:meth:`Grid.window` of one box ``(2,)``, as Python ints (bisection on the exact cell bounds)."""
@@ -86,11 +94,12 @@ class WindowDigMap(DigMap):
 
     def dig_disks(self, pos_lo: np.ndarray, pos_hi: np.ndarray, r: np.ndarray) -> None:
         """:meth:`DigMap.dig_disks` on each disk's window: a cell is dug when its farthest point from the
-        box (outward rounded) is strictly closer than ``r`` (:func:`.online_jit.dig_cells`)."""
+        box (outward rounded) is strictly closer than ``r`` (:func:`.dig_jit.dig_cells`)."""
         lo, hi, r = self._check(pos_lo, pos_hi, r)
         z = np.zeros(r.size)
-        dig_batch(self.free, self.free, self.xs, self.ys, self.nys, np.ascontiguousarray(lo),
-                  np.ascontiguousarray(hi), z, z, z, z, r, np.ones(r.size, dtype=bool))  # fmt: skip
+        batch = SectorBatch(np.ascontiguousarray(lo), np.ascontiguousarray(hi), z, z, z, z, r,
+                            np.ones(r.size, dtype=bool))  # fmt: skip
+        dig_batch(self.free, self.free, self.frame, batch)
 
     def dig_sectors(self, pos_lo: np.ndarray, pos_hi: np.ndarray, psi_lo: np.ndarray, psi_hi: np.ndarray,
                     alpha: np.ndarray, gamma: np.ndarray, r: np.ndarray) -> None:  # fmt: skip
@@ -101,9 +110,9 @@ class WindowDigMap(DigMap):
                                         (psi_lo, psi_hi, alpha, gamma))  # fmt: skip
         if not (psi_lo.shape == psi_hi.shape == alpha.shape == gamma.shape == r.shape):
             raise ValueError("psi_lo, psi_hi, alpha, gamma: expected one value per pose box")
-        dig_batch(self.free, self.free, self.xs, self.ys, self.nys, np.ascontiguousarray(lo),
-                  np.ascontiguousarray(hi), psi_lo, psi_hi, alpha, gamma, r,
-                  np.zeros(r.size, dtype=bool))  # fmt: skip
+        batch = SectorBatch(np.ascontiguousarray(lo), np.ascontiguousarray(hi), psi_lo, psi_hi, alpha, gamma,
+                            r, np.zeros(r.size, dtype=bool))  # fmt: skip
+        dig_batch(self.free, self.free, self.frame, batch)
 
     def clearance_window(self, r0: int, r1: int, c0: int, c1: int) -> np.ndarray:
         """Lower bound on ``dist(p, comp M⁻)`` for the cells ``[r0:r1, c0:c1]`` (see :meth:`clearance_lower`).
@@ -125,11 +134,10 @@ class WindowDigMap(DigMap):
 
         The centre distance ``D`` to the nearest not-free cell of the window (or of the ring around it,
         straight across) is a direct minimum over those cells (compiled,
-        :func:`.online_jit_pose.clearance_cells`), with the same bound ``D(1 - EDT_SLACK) - diag``.
+        :func:`.pose_jit.clearance_cells`), with the same bound ``D(1 - EDT_SLACK) - diag``.
         """
         w0, w1, v0, v1 = window
-        dx, dy = self.grid.cell_size
-        return _clearance_cells(self.free, b0, b1, a0, a1, w0, w1, v0, v1, dx, dy, self.keep, self.off)
+        return pose_jit.clearance_cells(self.free, self.frame, (b0, b1, a0, a1), (w0, w1, v0, v1))
 
     def contract_box(self, lo: np.ndarray, hi: np.ndarray, r_hi: float) -> tuple[np.ndarray, np.ndarray]:
         """Eq. 6.22 for one pose box: keep the hull of the cells with ``clearance <= r⁺`` (exact cell bounds).
@@ -141,9 +149,7 @@ class WindowDigMap(DigMap):
         x0, y0, x1, y1, r_hi = float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]), float(r_hi)
         if not (math.isfinite(r_hi) and gx0 <= x0 <= x1 <= gx1 and gy0 <= y0 <= y1 <= gy1):
             return lo, hi
-        dx, dy = self.grid.cell_size
-        c = _contract(self.free, self.xs, self.ys, self.nys, x0, y0, x1, y1, r_hi, dx, dy, self.keep,
-                      self.off)  # fmt: skip
+        c = pose_jit.contract(self.free, self.frame, x0, y0, x1, y1, r_hi)
         return np.array(c[:2]), np.array(c[2:])
 
 
@@ -173,6 +179,5 @@ def mark_possibly_sensed(
     if not (alpha.shape == gamma.shape == r_hi.shape):
         raise ValueError("alpha, gamma, r_hi: expected one value per sensor")
     lo, hi = np.asarray(lo, dtype=np.float64).ravel(), np.asarray(hi, dtype=np.float64).ravel()
-    mark_batch(maybe, np.array(grid.xs), np.array(grid.ys), -grid.ys, float(lo[0]), float(lo[1]),
-               float(hi[0]), float(hi[1]),
-               float(psi_lo), float(psi_hi), alpha, gamma, r_hi)  # fmt: skip
+    box = PoseBox(float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]), float(psi_lo), float(psi_hi))
+    mark_batch(maybe, grid_frame(grid), box, alpha, gamma, r_hi)

@@ -9,6 +9,8 @@ May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.sets`; numpy, n
 
 from .draw import (
     BOUNDARY_COLOR,
+    CLEAR_COLOR,
+    DARK_COLOR,
     INSIDE_COLOR,
     OUTSIDE_COLOR,
     PENUMBRA_COLOR,
@@ -24,6 +26,9 @@ from .paver import (
     PavingTree,
     pave,
 )
+from .paver_jit import (
+    pave_generation,
+)
 from .regular import (
     classify_grid,
 )
@@ -36,6 +41,8 @@ from .subpaving import (
 
 __all__ = [
     "BOUNDARY_COLOR",
+    "CLEAR_COLOR",
+    "DARK_COLOR",
     "INSIDE_COLOR",
     "OUTSIDE_COLOR",
     "PENUMBRA_COLOR",
@@ -50,6 +57,7 @@ __all__ = [
     "load",
     "new_figure",
     "pave",
+    "pave_generation",
     "save",
     "save_figure",
     "simplify",

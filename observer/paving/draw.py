@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 __all__ = [
-    "INSIDE_COLOR", "OUTSIDE_COLOR", "BOUNDARY_COLOR", "PENUMBRA_COLOR",
+    "INSIDE_COLOR", "OUTSIDE_COLOR", "BOUNDARY_COLOR", "CLEAR_COLOR", "PENUMBRA_COLOR", "DARK_COLOR",
     "new_figure", "draw_boxes", "draw_paving", "draw_grid", "draw_polygon", "save_figure",
 ]  # fmt: skip
 
@@ -89,7 +89,7 @@ def draw_boxes(
          np.stack([hi[:, 0], hi[:, 1]], 1), np.stack([lo[:, 0], hi[:, 1]], 1)], axis=1,
     )  # fmt: skip
     coll = PolyCollection(
-        verts,
+        verts,  # type: ignore[arg-type]  # matplotlib's stub: an (N, 4, 2) array is N polygons (its fast path)
         facecolors=color,
         edgecolors=edgecolor,
         linewidths=linewidth,

@@ -9,8 +9,6 @@ May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.expr`, :mod:`di
 
 from .ctc import (
     CtcPolar,
-    CtcPolarNumpy,
-    contract_polar,
 )
 from .sep import (
     SepCtcPreimage,
@@ -25,14 +23,12 @@ from .sep import (
 
 __all__ = [
     "CtcPolar",
-    "CtcPolarNumpy",
     "SepCtcPreimage",
     "SepLandmark",
     "SepPi",
     "SepPiInv",
     "SepPolarXY",
     "complement_boxes",
-    "contract_polar",
     "project_contract",
     "sep_landmark_fwdbwd",
 ]

@@ -12,9 +12,9 @@
   which a landmark ``m`` is seen at range ``[ρ]`` and bearing ``[θ]``, i.e. ``m - x ∈ π([ρ]×[θ])``.
 
 :class:`SepPiInv` and :class:`SepLandmark` separate a whole batch in one call of the compiled kernel
-:func:`.polar_jit.sep_pie_batch` (:meth:`~SepPiInv.separate_stacked`); their ``separate_numpy``
-methods run the same construction through :func:`project_contract` and the numpy contractor, as the
-kernel's test oracle.
+:func:`digslam.observer.core.polar_jit.sep_pie_batch` (:meth:`~SepPiInv.separate_stacked`); the same
+construction through :func:`project_contract` and a numpy contractor is the kernel's oracle in the tests
+(``tests/polar_oracle.py``).
 
 >>> s = SepLandmark((0.0, 0.0), (4.0, 6.0), (-np.pi / 12, np.pi / 4))     # §3.4.1.1
 >>> (ilo, ihi), (olo, ohi) = s.separate(np.array([[-6.0, -6.0]]), np.array([[4.0, 4.0]]))
@@ -29,10 +29,11 @@ from typing import Any
 import numpy as np
 
 from digslam.observer.core import rounding as rnd
-from digslam.observer.core.boxes import box_difference, empty_rows, normalize_empty
-from digslam.observer.core.polar_jit import cos_sin, sep_pie_batch
+from digslam.observer.core.boxes import box_difference, normalize_empty
+from digslam.observer.core.polar_jit import sep_pie_batch
+from digslam.observer.core.polar_ops_jit import cos_sin
 from digslam.observer.core.types import Batch
-from digslam.observer.polar.ctc import CtcPolar, CtcPolarNumpy
+from digslam.observer.polar.ctc import CtcPolar
 from digslam.observer.sets.contractors import Ctc
 from digslam.observer.sets.separators import Sep
 
@@ -89,16 +90,6 @@ def project_contract(
         np.maximum.at(rhi, dest, chi[:, x_cols])
     parts = [(rlo[i * n : (i + 1) * n], rhi[i * n : (i + 1) * n]) for i in range(g)]
     return parts[0] if groups is None else parts
-
-
-def _distance_range(lo: np.ndarray, hi: np.ndarray) -> Batch:
-    """Safe bounds of ``|p|`` over each ``(x, y)`` box (relative margin far above rounding)."""
-    mig = np.where((lo <= 0) & (hi >= 0), 0.0, np.minimum(np.abs(lo), np.abs(hi)))
-    mag = np.maximum(np.abs(lo), np.abs(hi))
-    with np.errstate(over="ignore", invalid="ignore"):
-        dmin = np.sqrt((mig * mig).sum(axis=1)) * (1 - 2.0**-40)
-        dmax = np.sqrt((mag * mag).sum(axis=1)) * (1 + 2.0**-40) + 2.0**-1000
-    return dmin, np.where(np.isnan(dmax), _INF, dmax)
 
 
 class SepCtcPreimage(Sep):
@@ -217,6 +208,11 @@ class SepPiInv(Sep):
 
     Raises:
         ValueError: on a negative range, or an aperture ``<= 0`` or ``>= 2π``.
+
+    Attributes:
+        pie: the ``(ρ, θ)`` box ``[ρ]×[θ]`` as a ``(lo, hi)`` pair of ``(1, 2)`` arrays.
+        ybar: the subpaving ``Ȳ`` (at most 3 boxes) of the rest of the fundamental domain, same form.
+        convex: whether the aperture is certainly below π (the cone is convex).
     """
 
     n = 2
@@ -231,28 +227,10 @@ class SepPiInv(Sep):
             pieces.append(((r1, t0), (_INF, end)))  # beyond the outer circle
         self.pie = (np.array([[r0, t0]]), np.array([[r1, t1]]))
         self.convex = t1 - t0 < 3.0  # aperture certainly below π
-        self.cs = (np.cos(t0), np.sin(t0), np.cos(t1), np.sin(t1))
         self.ybar = (np.array([p[0] for p in pieces]), np.array([p[1] for p in pieces]))
         rows = [(r0, r1, t0, t1)] + [(a[0], b[0], a[1], b[1]) for a, b in pieces]
         self._pieces = np.array(rows, dtype=np.float64)  # (ρ⁻, ρ⁺, θ⁻, θ⁺): the pie, then Ȳ
         self._cs = np.array([cos_sin(r[2], r[3], np.zeros(8)) for r in rows])
-
-    def _cone_sides(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Boxes certainly inside the open cone ``θ⁻ < arg p < θ⁺``, and certainly outside the closed one.
-
-        Each corner is tested against the two half-planes ``e(θ⁻) × p > 0`` and ``p × e(θ⁺) > 0`` with a
-        margin far above the rounding of the cross products (``cos``/``sin`` to a few ulps).
-        """
-        xs = np.stack([lo[:, 0], lo[:, 0], hi[:, 0], hi[:, 0]], axis=1)
-        ys = np.stack([lo[:, 1], hi[:, 1], lo[:, 1], hi[:, 1]], axis=1)
-        with np.errstate(invalid="ignore", over="ignore"):
-            margin = (np.abs(xs) + np.abs(ys)) * 2.0**-44 + 2.0**-1000
-            a = self.cs[0] * ys - self.cs[1] * xs  # e(θ⁻) × p
-            b = self.cs[3] * xs - self.cs[2] * ys  # p × e(θ⁺)
-            inside = ((a > margin) & (b > margin)).all(axis=1)
-            outside = (a < -margin).all(axis=1) | (b < -margin).all(axis=1)
-        finite = np.isfinite(lo).all(axis=1) & np.isfinite(hi).all(axis=1)
-        return inside & finite, outside & finite
 
     def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
         r = self.separate_stacked(lo, hi)
@@ -265,24 +243,6 @@ class SepPiInv(Sep):
             raise ValueError(f"lo, hi: expected two (N, 2) batches, got {lo.shape} and {hi.shape}")
         mm = np.zeros(2) if m is None else m
         return sep_pie_batch(lo, hi, mm, m is not None, self._pieces, self._cs, self.convex)
-
-    def separate_numpy(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
-        """The same separation with the numpy contractor :func:`.polar_ctc.contract_polar` (test oracle)."""
-        cols = np.array([0, 1])
-        dmin, dmax = _distance_range(lo, hi)
-        ok = ~empty_rows(lo, hi)
-        # a piece [r0, r1]×[θ] can only meet boxes whose distance range meets [r0, r1]
-        rl, rh = np.r_[self.pie[0][:, 0], self.ybar[0][:, 0]], np.r_[self.pie[1][:, 0], self.ybar[1][:, 0]]
-        live = ok[:, None] & (dmax[:, None] >= rl[None]) & (dmin[:, None] <= rh[None])
-        if self.convex:  # aperture < π: the cone is convex, decide it from the corners
-            inside, outside = self._cone_sides(lo, hi)
-            live[:, 0] &= ~outside  # the pie misses a box outside the cone
-            live[:, 1] &= ~inside  # the rest of the turn misses a box inside the open cone
-        ylo, yhi = np.r_[self.pie[0], self.ybar[0]], np.r_[self.pie[1], self.ybar[1]]
-        groups = np.r_[0, np.ones(len(self.ybar[0]), dtype=np.int64)]
-        ctc = CtcPolarNumpy(need_theta=False)
-        xout, xin = project_contract(ctc, cols, lo, hi, ylo, yhi, live=live, groups=groups, n_groups=2)
-        return xin, xout
 
 
 #: the separator of ``(x, y)`` points inside a ``(ρ, θ)`` pie, under codac's naming
@@ -307,26 +267,12 @@ class SepLandmark(Sep):
             raise ValueError(f"m: expected a finite landmark position (m1, m2), got {m!r}")
         self.m, self.pie = mm, SepPiInv(rho, theta)
 
-    def _g(self, lo: np.ndarray, hi: np.ndarray) -> Batch:
-        e = empty_rows(lo, hi)[:, None]
-        glo, ghi = rnd.sub_down(self.m, hi), rnd.sub_up(self.m, lo)
-        return np.where(e, _INF, glo), np.where(e, -_INF, ghi)
-
     def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
         r = self.separate_stacked(lo, hi)
         return (r[0], r[1]), (r[2], r[3])
 
     def separate_stacked(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         return self.pie.separate_stacked(lo, hi, self.m)
-
-    def separate_numpy(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
-        """The same separation through :meth:`SepPiInv.separate_numpy` (test oracle)."""
-        ulo, uhi = self._g(lo, hi)
-        res = []
-        for b in self.pie.separate_numpy(ulo, uhi):
-            xlo, xhi = self._g(*b)
-            res.append(normalize_empty(np.maximum(xlo, lo), np.minimum(xhi, hi)))
-        return res[0], res[1]
 
 
 def sep_landmark_fwdbwd(m: Any, rho: Any, theta: Any) -> Sep:

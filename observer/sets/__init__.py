@@ -29,8 +29,10 @@ from .minkowski import (
 from .projection import (
     SepOnDims,
     SepProj,
+    bounded_box,
 )
 from .registration import (
+    ParamTransform,
     SepRegistration,
     rigid2d,
     scaling,
@@ -65,6 +67,9 @@ from .separators import (
     inter_batch,
     relaxed_intersection,
 )
+from .separators_jit import (
+    fold_separated,
+)
 from .testing import (
     assert_separator_sound,
     random_boxes,
@@ -87,6 +92,7 @@ __all__ = [
     "CtcSegments",
     "CtcTransform",
     "CtcUnion",
+    "ParamTransform",
     "Sep",
     "SepBox",
     "SepImage",
@@ -104,7 +110,9 @@ __all__ = [
     "SepUnion",
     "Transform",
     "assert_separator_sound",
+    "bounded_box",
     "check_separation",
+    "fold_separated",
     "forward",
     "hc4_backward",
     "hull_batch",

@@ -40,7 +40,7 @@ class Ctc:
     def __call__(self, boxes: IntervalArray | tuple[Any, Any]) -> Any:
         """Contract an :class:`IntervalArray` box ``(n,)`` or batch ``(N, n)``, or a ``(lo, hi)`` pair."""
         is_ia = isinstance(boxes, IntervalArray)
-        lo, hi = boxes.pair if is_ia else boxes
+        lo, hi = boxes.pair if isinstance(boxes, IntervalArray) else boxes
         single = np.ndim(lo) == 1
         lo, hi = validate_batch(lo, hi, "boxes", self.n)
         rlo, rhi = normalize_empty(*self.contract(lo, hi))
@@ -146,7 +146,7 @@ class CtcFwdBwd(Ctc):
 
     One call runs one forward pass (natural inclusion of every node), intersects the outputs with
     ``[y]``, and one backward pass (projection rules of :mod:`.backward`) down to the variables:
-    compiled (:mod:`.jit_hc4`) when ``f`` has a :class:`~.jit_tape.Tape`, else with numpy
+    compiled (:mod:`.hc4_jit`) when ``f`` has a :class:`~.tape_jit.Tape`, else with numpy
     (:func:`hc4_backward`, which also serves the functions with trigonometric, ``min``/``max`` or
     ``atan2`` nodes).
 

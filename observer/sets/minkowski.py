@@ -26,7 +26,7 @@ import numpy as np
 
 from digslam.observer.core.types import Batch
 from digslam.observer.expr.expr import Function
-from digslam.observer.sets.projection import _one_box
+from digslam.observer.sets.projection import bounded_box
 from digslam.observer.sets.registration import SepRegistration, translation
 from digslam.observer.sets.sep_inverse import SepInverse
 from digslam.observer.sets.separators import Sep, SepNot
@@ -61,7 +61,7 @@ class SepMinkowskiDiff(Sep):
     """
 
     def __init__(self, sep_b: Sep, sep_a: Sep, a_box: Any, eps: float, **proj_kw: Any) -> None:
-        n = _one_box(a_box, "a_box")[0].size
+        n = bounded_box(a_box, "a_box")[0].size
         if sep_b.n is not None and sep_b.n != n:
             raise ValueError(f"sep_b: dimension {sep_b.n}, but a_box has dimension {n}")
         self.reg = SepRegistration(sep_a, sep_b, translation(n), a_box, eps, "inclusion", **proj_kw)
@@ -90,7 +90,7 @@ class SepMinkowskiSum(Sep):
     """
 
     def __init__(self, sep_a: Sep, sep_b: Sep, a_box: Any, eps: float, **proj_kw: Any) -> None:
-        alo, ahi = _one_box(a_box, "a_box")
+        alo, ahi = bounded_box(a_box, "a_box")
         n = alo.size
         if sep_a.n is not None and sep_a.n != n:
             raise ValueError(f"sep_a: dimension {sep_a.n}, but a_box has dimension {n}")

@@ -50,7 +50,7 @@ from digslam.observer.core.interval import IntervalArray
 from digslam.observer.core.types import Batch
 from digslam.observer.sets.separators import Sep, inter_batch
 
-__all__ = ["SepProj", "SepOnDims"]
+__all__ = ["SepOnDims", "SepProj", "bounded_box"]
 
 
 def _dims(dims: Sequence[int], n: int, name: str) -> np.ndarray:
@@ -64,8 +64,13 @@ def _dims(dims: Sequence[int], n: int, name: str) -> np.ndarray:
     return d
 
 
-def _one_box(box: Any, name: str) -> Batch:
-    """Bounds of one box: an :class:`IntervalArray` ``(p,)`` or ``(lo, hi)`` pairs of shape ``(p, 2)``."""
+def bounded_box(box: Any, name: str) -> Batch:
+    """Bounds ``(lo, hi)`` of one non-empty bounded box (a parameter domain, which gets bisected): an
+    :class:`IntervalArray` ``(p,)`` or an array-like of ``(lo, hi)`` pairs of shape ``(p, 2)``.
+
+    Raises:
+        ValueError: naming ``name``, on another shape, a NaN, an empty or an unbounded side.
+    """
     if isinstance(box, IntervalArray):
         lo, hi = np.atleast_1d(box.lo), np.atleast_1d(box.hi)
     else:
@@ -157,7 +162,7 @@ class SepProj(Sep):
         max_pairs: int = 1 << 21, presplit: int = 0, fixpoint: bool = False, fixpoint_ratio: float = 1e-3,
         max_rounds: int = 50,
     ) -> None:  # fmt: skip
-        ylo, yhi = _one_box(y_box, "y_box")
+        ylo, yhi = bounded_box(y_box, "y_box")
         p = ylo.size
         nz = sep.n if sep.n is not None else len(list(dims_kept)) + p
         self.kept = _dims(dims_kept, nz, "dims_kept")

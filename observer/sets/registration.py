@@ -30,19 +30,20 @@ import numpy as np
 from digslam.observer.core.interval import IntervalArray
 from digslam.observer.core.types import Batch
 from digslam.observer.expr.expr import Expr, Function
-from digslam.observer.sets.projection import SepOnDims, SepProj, _one_box
+from digslam.observer.sets.projection import SepOnDims, SepProj, bounded_box
 from digslam.observer.sets.sep_inverse import SepInverse
 from digslam.observer.sets.separators import Sep, SepInter, SepNot
 
 __all__ = [
-    "SepRegistration", "sep_inclusion", "sep_intersection", "sep_cone", "translation", "rigid2d", "scaling",
-    "transform_function",
+    "ParamTransform", "SepRegistration", "sep_inclusion", "sep_intersection", "sep_cone", "translation",
+    "rigid2d", "scaling", "transform_function",
 ]  # fmt: skip
 
-Transform = Callable[[Sequence[Expr], Sequence[Expr]], Any]
+#: a parametric transformation ``f(a, p)`` on expressions: the point ``a`` moved by the parameter ``p``
+ParamTransform = Callable[[Sequence[Expr], Sequence[Expr]], Any]
 
 
-def translation(n: int) -> Transform:
+def translation(n: int) -> ParamTransform:
     """``f(a, p) = a + p`` on ``Rⁿ`` (the Minkowski case, Prop. 4.1): ``q = n``."""
     if n < 1:
         raise ValueError(f"n: dimension must be >= 1, got {n}")
@@ -54,7 +55,7 @@ def translation(n: int) -> Transform:
     return f
 
 
-def rigid2d() -> Transform:
+def rigid2d() -> ParamTransform:
     """``f(a, (x, y, θ)) = R(θ) a + (x, y)``: rotation then translation in the plane (``q = 3``)."""
     from digslam.observer.expr.ops import cos, sin
 
@@ -66,7 +67,7 @@ def rigid2d() -> Transform:
     return f
 
 
-def scaling() -> Transform:
+def scaling() -> ParamTransform:
     """``f(a, d) = d · a`` (the sonar simulation of §4.2.3, Eq. 4.22): ``q = 1``, any ``n``."""
 
     def f(a: Sequence[Expr], p: Sequence[Expr]) -> tuple[Expr, ...]:
@@ -76,7 +77,7 @@ def scaling() -> Transform:
     return f
 
 
-def transform_function(f: Transform | Function, n: int, q: int, m: int | None) -> Function:
+def transform_function(f: ParamTransform | Function, n: int, q: int, m: int | None) -> Function:
     """``f`` as a :class:`Function` of ``z = (a, p) ∈ R^(n+q)``, checked to have ``m`` outputs.
 
     Args:
@@ -133,7 +134,7 @@ class SepRegistration(Sep):
         self,
         sep_a: Sep,
         sep_b: Sep,
-        f: Transform | Function,
+        f: ParamTransform | Function,
         a_box: Any,
         eps: float,
         mode: str = "inclusion",
@@ -142,7 +143,7 @@ class SepRegistration(Sep):
     ) -> None:
         if mode not in ("inclusion", "intersection"):
             raise ValueError(f"mode: expected 'inclusion' or 'intersection', got {mode!r}")
-        alo, ahi = _one_box(a_box, "a_box")
+        alo, ahi = bounded_box(a_box, "a_box")
         n = alo.size
         if sep_a.n is not None and sep_a.n != n:
             raise ValueError(f"a_box: dimension {n}, but sep_a has dimension {sep_a.n}")
@@ -165,13 +166,15 @@ class SepRegistration(Sep):
         return self.sep.separate(lo, hi)
 
 
-def sep_inclusion(sep_a: Sep, sep_b: Sep, f: Transform | Function, a_box: Any, eps: float, **kw: Any) -> Sep:
+def sep_inclusion(
+    sep_a: Sep, sep_b: Sep, f: ParamTransform | Function, a_box: Any, eps: float, **kw: Any
+) -> Sep:
     """Separator of ``{p | f(A, p) ⊂ B}`` (Eq. 4.13, 4.16); see :class:`SepRegistration`."""
     return SepRegistration(sep_a, sep_b, f, a_box, eps, mode="inclusion", **kw)
 
 
 def sep_intersection(
-    sep_a: Sep, sep_b: Sep, f: Transform | Function, a_box: Any, eps: float, **kw: Any
+    sep_a: Sep, sep_b: Sep, f: ParamTransform | Function, a_box: Any, eps: float, **kw: Any
 ) -> Sep:
     """Separator of ``{p | f(A, p) ∩ B ≠ ∅}`` (Eq. 4.19–4.20); see :class:`SepRegistration`."""
     return SepRegistration(sep_a, sep_b, f, a_box, eps, mode="intersection", **kw)

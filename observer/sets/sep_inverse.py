@@ -2,9 +2,9 @@
 
 One forward pass evaluates ``f`` on the batch; backward passes then project ``Y`` (for ``x_out``)
 and the closed complement of ``Y`` (for ``x_in``) back onto the boxes. ``Y`` is an interval, a box,
-or any separator in the image space. When ``f`` has a :class:`~.jit_tape.Tape` (no trigonometric,
+or any separator in the image space. When ``f`` has a :class:`~.tape_jit.Tape` (no trigonometric,
 ``min``/``max`` or ``atan2`` node) the whole batch is separated by compiled kernels
-(:mod:`.jit_hc4`); otherwise by the numpy forward-backward of :mod:`.contractors`.
+(:mod:`.hc4_jit`); otherwise by the numpy forward-backward of :mod:`.contractors`.
 
 >>> ring = SepInverse(Function(lambda x: (x[0] - 2) ** 2 + (x[1] - 2.5) ** 2), Interval(1, 2.25))
 >>> xin, xout = ring(Box([(3.1, 3.2), (2.4, 2.6)]))        # inside the ring of Ex. 2.7
@@ -37,7 +37,8 @@ class SepInverse(Sep):
 
         centred: intersect ``f``'s natural enclosure with its centred (mean-value) form before the
             backward passes (:mod:`.centred`, Eq. 2.20): fewer bisections near the boundary when
-            variables occur several times; off by default (measured in ``tests/test_centred_form.py``).
+            variables occur several times; off by default (measured in
+            ``tests/observer/expr/test_centred.py``).
 
     Raises:
         ValueError: if ``y``'s dimension is not ``m``.

@@ -187,7 +187,7 @@ class CtcSegments(Ctc):
         ok = (tl <= tu)[:, None] & (xl <= xu)
         out_lo, out_hi = np.full(near.shape[:1] + (2,), np.inf), np.full(near.shape[:1] + (2,), -np.inf)
         if len(r):
-            ok = ok.all(axis=1)[:, None]
+            ok = np.asarray(ok.all(axis=1))[:, None]
             starts = np.flatnonzero(np.r_[True, r[1:] != r[:-1]])
             out_lo[r[starts]] = np.minimum.reduceat(np.where(ok, xl, np.inf), starts)
             out_hi[r[starts]] = np.maximum.reduceat(np.where(ok, xu, -np.inf), starts)

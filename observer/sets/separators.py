@@ -21,8 +21,8 @@ import numpy as np
 
 from digslam.observer.core.boxes import empty_rows, normalize_empty, validate_batch
 from digslam.observer.core.interval import IntervalArray, as_pair
-from digslam.observer.core.scalar_jit import njit
 from digslam.observer.core.types import Batch
+from digslam.observer.sets.separators_jit import fold_separated
 
 
 class Sep:
@@ -47,7 +47,7 @@ class Sep:
     def __call__(self, boxes: IntervalArray | tuple[Any, Any]) -> tuple[Any, Any]:
         """Separate an :class:`IntervalArray` box ``(n,)`` / batch ``(N, n)``, or a ``(lo, hi)`` pair."""
         is_ia = isinstance(boxes, IntervalArray)
-        lo, hi = boxes.pair if is_ia else boxes
+        lo, hi = boxes.pair if isinstance(boxes, IntervalArray) else boxes
         single = np.ndim(lo) == 1
         lo, hi = validate_batch(lo, hi, "boxes", self.n)
         res = []
@@ -88,35 +88,6 @@ def hull_batch(a: Batch, b: Batch) -> Batch:
     return np.minimum(a[0], b[0]), np.maximum(a[1], b[1])
 
 
-@njit
-def _fold(acc: np.ndarray, s: np.ndarray, lo: np.ndarray, hi: np.ndarray, union: bool) -> np.ndarray:
-    """Fold one separated batch ``s (4, N, n)`` into ``acc`` by Eq. 2.54 (a new ``acc`` when it is
-    ``(0, 0, 0)``): for ``&``, ``x_in ⊔= s_in`` and ``x_out ∩= s_out``; for ``|`` the other way round.
-    The intersections are also met with ``[x]``; empty rows come out as ``[+inf, -inf]``."""
-    nb, n = lo.shape
-    h, m = (2, 0) if union else (0, 2)  # the part taking the hull, the part taking the meet
-    if acc.shape[0] == 0:
-        acc = np.empty((4, nb, n))
-        acc[h], acc[h + 1] = np.inf, -np.inf
-        acc[m], acc[m + 1] = lo, hi
-    for r in range(nb):
-        empty = False
-        for i in range(n):
-            empty |= s[h, r, i] > s[h + 1, r, i]
-        if not empty:
-            for i in range(n):
-                acc[h, r, i] = min(acc[h, r, i], s[h, r, i])
-                acc[h + 1, r, i] = max(acc[h + 1, r, i], s[h + 1, r, i])
-        empty = False
-        for i in range(n):
-            acc[m, r, i] = max(acc[m, r, i], s[m, r, i], lo[r, i])
-            acc[m + 1, r, i] = min(acc[m + 1, r, i], s[m + 1, r, i], hi[r, i])
-            empty |= acc[m, r, i] > acc[m + 1, r, i]
-        if empty:
-            acc[m, r], acc[m + 1, r] = np.inf, -np.inf
-    return acc
-
-
 _NONE = np.empty((0, 0, 0))
 
 
@@ -153,7 +124,7 @@ class SepInter(_Stacked):
         lo, hi = np.ascontiguousarray(lo, dtype=np.float64), np.ascontiguousarray(hi, dtype=np.float64)
         acc = _NONE
         for s in self.seps:
-            acc = _fold(acc, np.ascontiguousarray(s.separate_stacked(lo, hi)), lo, hi, self.union)
+            acc = fold_separated(acc, np.ascontiguousarray(s.separate_stacked(lo, hi)), lo, hi, self.union)
         return acc
 
 
@@ -230,7 +201,7 @@ class SepBox(Sep):
         of ``[x]`` lies strictly beyond the bound (a box touching ``[y]`` from inside is not outside).
         """
         out = []
-        for k in range(self.n):
+        for k in range(self.box[0].size):
             for side in (0, 1):
                 plo, phi = lo.copy(), hi.copy()
                 if side == 0:

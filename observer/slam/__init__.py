@@ -11,6 +11,7 @@ May import: every folder of :mod:`digslam.observer` except :mod:`~digslam.observ
 """
 
 from .digmap import (
+    EDT_SLACK,
     DigMap,
 )
 from .digslam import (
@@ -20,6 +21,7 @@ from .digslam import (
     dig_slam,
     explored_zone,
     impact_bound,
+    odometry_velocity,
 )
 from .explicit_slam import (
     ExplicitSlamConfig,
@@ -37,14 +39,18 @@ from .explicit_slam import (
     shape_register,
 )
 from .explored import (
+    BLOCK,
     SepExploredDisks,
     check_interval,
     check_tube,
+    codes,
     explored_disks_grid,
     explored_disks_thick_sep,
     explored_hypotheses,
     explored_thick_sep,
     explored_union,
+    pair_test,
+    row_intervals,
 )
 from .explored_sweep import (
     explored_sectors_grid,
@@ -85,10 +91,12 @@ from .shapes import (
 )
 
 __all__ = [
+    "BLOCK",
     "CtcLandmarks",
     "DigMap",
     "DigSlamConfig",
     "DigSlamResult",
+    "EDT_SLACK",
     "ExplicitSlamConfig",
     "ExplicitSlamResult",
     "Grid",
@@ -109,6 +117,7 @@ __all__ = [
     "ThickMap",
     "check_interval",
     "check_tube",
+    "codes",
     "contract_detections",
     "contract_disjunctive",
     "ctc_minus",
@@ -130,8 +139,11 @@ __all__ = [
     "localize",
     "measurement_shapes",
     "mission_tube",
+    "odometry_velocity",
     "overlap_pretest",
+    "pair_test",
     "register_translation",
+    "row_intervals",
     "shape_carve",
     "shape_register",
     "shape_slam",

@@ -271,4 +271,4 @@ class DigMap:
         lo[dead], hi[dead] = np.inf, -np.inf
 
 
-__all__ = ["DigMap"]
+__all__ = ["DigMap", "EDT_SLACK"]

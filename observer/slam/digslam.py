@@ -4,7 +4,8 @@ From a recorded mission (bounded speed, yaw rate, compass heading and range inte
 the robot's positions in a tube, proves which cells are free (the dig zone ``M⁻``) and which were
 explored, and iterates the two contractors of the constraint network (6.24) to a fixpoint:
 
-1. ``[x](·) := C_d/dt([x](·))`` with ``ẋ = v (cos ψ, sin ψ)`` (Eq. 6.23), forward and backward;
+1. ``[x](·) := C_d/dt([x](·))`` with ``ẋ = R(ψ) v`` and the body-frame velocity ``v = (v_1, v_2)``
+   (Eq. 3.59, 6.12, B.20; Eq. 6.23 is the unicycle ``v_2 = 0``), forward and backward;
 2. ``M⁻ := M⁻ ∪ g⁻¹_{[x](t_i)}(Z(t_i))`` for every reading (Eq. 6.21, :meth:`DigMap.dig_disks`,
    :meth:`DigMap.dig_sectors`);
 3. ``[x](t_i) := C_g^≠([x](t_i), ΔZ(t_i), M⁻)`` (Eq. 6.22, :meth:`DigMap.contract_impacts`).
@@ -14,9 +15,9 @@ all the gates, then contracts all the gates against the whole ``M⁻`` (a Jacobi
 least as strong as its sequential loop since ``M⁻`` only grows). An empty gate means the data contradict
 their bounds: the result then says so (``consistent`` is False) and carries no sets.
 
-Data contract (:mod:`.record`): ``speed[k]`` and ``yaw_rate[k]`` bound the true values over the whole
-slice ``[t_{k-1}, t_k]`` that ends at ``t_k``; ``heading[k]`` bounds the heading at ``t_k``; ``range[k]``
-bounds the ranges from the pose at ``t_k``.
+Data contract (:mod:`.record`): ``speed[k]``, ``lateral[k]`` (the body-frame velocity ``v_1``, ``v_2``) and
+``yaw_rate[k]`` bound the true values over the whole slice ``[t_{k-1}, t_k]`` that ends at ``t_k``;
+``heading[k]`` bounds the heading at ``t_k``; ``range[k]`` bounds the ranges from the pose at ``t_k``.
 
 >>> from digslam.observer.slam.record import MissionRecord
 >>> n = 11
@@ -38,16 +39,18 @@ from typing import Any
 import numpy as np
 
 from digslam.observer.core import rounding as rnd
+from digslam.observer.core.config import Config, check_finite_nonneg, check_int, config_dataclass
+from digslam.observer.core.types import Pair
 from digslam.observer.slam.digmap import DigMap
 from digslam.observer.slam.explored import explored_disks_grid, explored_union
 from digslam.observer.slam.grid import Grid
 from digslam.observer.slam.record import MissionRecord
 from digslam.observer.thick.sep import CLEAR, DARK, UNKNOWN
-from digslam.observer.tube.tube import Tube, ctc_deriv, heading_from_compass, unicycle_velocity
+from digslam.observer.tube.tube import Tube, body_velocity, ctc_deriv, heading_from_compass
 
 
-@dataclass(frozen=True)
-class DigSlamConfig:
+@config_dataclass
+class DigSlamConfig(Config):
     """Settings of :func:`dig_slam`.
 
     Attributes:
@@ -64,19 +67,8 @@ class DigSlamConfig:
     explored: bool = True
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.max_iter, int) and self.max_iter >= 1):
-            raise ValueError(f"max_iter: must be an integer >= 1, got {self.max_iter!r}")
-        if not (np.isfinite(self.tol) and self.tol >= 0):
-            raise ValueError(f"tol: must be a finite number >= 0, got {self.tol!r}")
-
-    @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> DigSlamConfig:
-        """Build from a mapping; an unknown key raises ``ValueError`` naming it."""
-        known = set(cls.__dataclass_fields__)
-        unknown = sorted(set(data) - known)
-        if unknown:
-            raise ValueError(f"DigSlamConfig: unknown key(s) {unknown}; known: {sorted(known)}")
-        return cls(**data)
+        check_int("max_iter", self.max_iter, 1)
+        check_finite_nonneg("tol", self.tol)
 
 
 @dataclass
@@ -89,7 +81,7 @@ class DigSlamResult:
         tube: the contracted position tube (None when inconsistent).
         dig: the dig zone ``M⁻`` (None when inconsistent).
         explored: the explored zone ``[Z⁻, Z⁺]`` on the grid (App. B), int8 codes of
-            :mod:`.thick_sep` (clear, penumbra, dark, unknown); None when inconsistent.
+            :mod:`.thick.sep` (clear, penumbra, dark, unknown); None when inconsistent.
         heading: the heading tube used for the velocity (compass and gyro fused).
         iterations: fixpoint iterations run.
         widths: per iteration, gate widths ``(T+1,)`` before the impact contractor, after it, and after
@@ -155,6 +147,20 @@ def dig_readings(
                     record.alpha[k[c], s[c]], record.gamma[k[c], s[c]], r[c])  # fmt: skip
 
 
+def odometry_velocity(record: MissionRecord, heading: Tube) -> Pair:
+    """Per-slice velocity boxes ``[u_k] ⊃ {R(ψ) v}`` of ``ẋ = R(ψ) v`` (Eq. 3.59, 6.12, B.20):
+    ``v = (v_1, v_2) ∈ ([speed_k], [lateral_k])`` and ``ψ`` in the heading tube's slice ``k``
+    (:func:`~.tube.body_velocity`; a unicycle record, ``lateral = [0, 0]``, gives the tube of Eq. 6.23 to
+    the bit).
+
+    Returns:
+        ``(u_lo, u_hi)`` of shape ``(T, 2)``, slice ``k`` bounded by record ``k + 1``'s odometry.
+    """
+    v_lo = np.stack([record.speed[1:, 0], record.lateral[1:, 0]], axis=1)
+    v_hi = np.stack([record.speed[1:, 1], record.lateral[1:, 1]], axis=1)
+    return body_velocity(v_lo, v_hi, heading.slice_lo[:, 0], heading.slice_hi[:, 0])
+
+
 def impact_bound(record: MissionRecord) -> np.ndarray:
     """Per time, the smallest upper range bound over the echoing sensors (``inf`` if none echoed)."""
     hi = np.where(record.no_echo, np.inf, record.range[..., 1])
@@ -190,13 +196,13 @@ def dig_slam(
     if heading.is_empty():  # compass and gyro contradict each other
         at = heading.inconsistent_at if heading.inconsistent_at is not None else heading.first_empty()
         return DigSlamResult(False, at, None, None, heading, 0)
-    u_lo, u_hi = unicycle_velocity(record.speed[1:, 0], record.speed[1:, 1],
-                                   heading.slice_lo[:, 0], heading.slice_hi[:, 0])  # fmt: skip
+    u_lo, u_hi = odometry_velocity(record, heading)
     n = t.shape[0]
     g_lo, g_hi = np.full((n, 2), -np.inf), np.full((n, 2), np.inf)
     g_lo[0], g_hi[0] = x0_lo, x0_hi
     tube = ctc_deriv(Tube(t, g_lo, g_hi), u_lo, u_hi, forward=True, backward=False)
-    res = DigSlamResult(True, None, tube, DigMap(grid), heading, 0, dead_reckoning=tube.widths())
+    dig = DigMap(grid)
+    res = DigSlamResult(True, None, tube, dig, heading, 0, dead_reckoning=tube.widths())
     r_hi = impact_bound(record)
     total = float(np.sum(tube.widths()))
     dug_lo, dug_hi = np.full_like(tube.gate_lo, np.nan), np.full_like(tube.gate_hi, np.nan)
@@ -204,10 +210,10 @@ def dig_slam(
         before = tube.widths()
         # a gate dug before and unchanged since digs nothing new
         changed = np.any((tube.gate_lo != dug_lo) | (tube.gate_hi != dug_hi), axis=1)
-        dig_readings(res.dig, record, tube, heading, changed)
+        dig_readings(dig, record, tube, heading, changed)
         dug_lo, dug_hi = tube.gate_lo.copy(), tube.gate_hi.copy()
         if cfg.impacts:
-            lo, hi = res.dig.contract_impacts(tube.gate_lo, tube.gate_hi, r_hi)
+            lo, hi = dig.contract_impacts(tube.gate_lo, tube.gate_hi, r_hi)
             tube = Tube(t, lo, hi, tube.slice_lo, tube.slice_hi)
         after = tube.widths()
         tube = ctc_deriv(tube, u_lo, u_hi)
@@ -226,4 +232,12 @@ def dig_slam(
     return res
 
 
-__all__ = ["DigSlamConfig", "DigSlamResult", "dig_readings", "dig_slam", "explored_zone", "impact_bound"]
+__all__ = [
+    "DigSlamConfig",
+    "DigSlamResult",
+    "dig_readings",
+    "dig_slam",
+    "explored_zone",
+    "impact_bound",
+    "odometry_velocity",
+]

@@ -23,7 +23,7 @@ cells), and the measurements come in families that act on all the gates of the t
   shapes ``M⁺`` stays ``R^q`` and the registration of Prop. 5.4 is void (Eq. 6.19–6.21), so the impact
   zone is what localizes.
 
-Special cases (tested in ``tests/test_explicit_slam.py``):
+Special cases (tested in ``tests/observer/slam/test_explicit_slam.py``):
 
 * Algorithm 6.3 (:func:`~.digslam.dig_slam`) is :func:`explicit_slam` with one
   :class:`RangeMeasurements` family: same schedule, same contractors, so the same tube and ``M⁻``
@@ -59,12 +59,12 @@ from digslam.observer.core.types import Batch
 from digslam.observer.expr.expr import Function
 from digslam.observer.sets.separators import Sep
 from digslam.observer.slam.digmap import DigMap
-from digslam.observer.slam.digslam import dig_readings, impact_bound
+from digslam.observer.slam.digslam import dig_readings, impact_bound, odometry_velocity
 from digslam.observer.slam.grid import Grid
 from digslam.observer.slam.record import MissionRecord
 from digslam.observer.thick.carving import param_hull
 from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
-from digslam.observer.tube.tube import Tube, ctc_deriv, heading_from_compass, unicycle_velocity
+from digslam.observer.tube.tube import Tube, ctc_deriv, heading_from_compass
 
 __all__ = [
     "ExplicitSlamConfig", "ExplicitSlamResult", "MapFunction", "Measurements", "RangeMeasurements",
@@ -94,7 +94,7 @@ class ThickMap(DigMap):
         return self.free
 
     def codes(self) -> np.ndarray:
-        """int8 codes of :mod:`.thick_sep`: CLEAR in ``M⁻``, DARK outside ``M⁺``, PENUMBRA between."""
+        """int8 codes of :mod:`.thick.sep`: CLEAR in ``M⁻``, DARK outside ``M⁺``, PENUMBRA between."""
         out = np.full(self.grid.shape, PENUMBRA, dtype=np.int8)
         out[self.free] = CLEAR
         out[~self.upper] = DARK
@@ -273,7 +273,8 @@ def shape_carve(m: ThickMap, z: RasterShape, g: MapFunction, x_lo: np.ndarray, x
         return
     c_lo, c_hi = m.grid.cell_boxes(rows, cols)
     k = rows.size
-    w = z.windows(*g.image(np.repeat(x_lo, k, 0), np.repeat(x_hi, k, 0), c_lo, c_hi), "overlaps")
+    z_lo, z_hi = g.image(np.repeat(x_lo, k, 0), np.repeat(x_hi, k, 0), c_lo, c_hi)
+    w = z.windows(z_lo, z_hi, "overlaps")
     inside = z.inside(*w)
     into = inside & (z.count("notlower", *w) == 0)
     out = inside & (z.count("upper", *w) == 0)
@@ -506,7 +507,7 @@ def explicit_slam(tube: Tube, u_lo: Any, u_hi: Any, measurements: Sequence[Measu
 
     Args:
         tube: the initial tube (``[x](0) = X₀``, entire elsewhere).
-        u_lo, u_hi: ``(T, n)`` velocity bounds per slice (``ẋ ∈ [u]``, e.g. :func:`~.tube.unicycle_velocity`).
+        u_lo, u_hi: ``(T, n)`` velocity bounds per slice (``ẋ ∈ [u]``, e.g. :func:`~.tube.body_velocity`).
         measurements: families of measurements (:class:`ShapeMeasurements`, :class:`RangeMeasurements`).
         grid: the cells of the map.
         config: :class:`ExplicitSlamConfig`.
@@ -516,8 +517,8 @@ def explicit_slam(tube: Tube, u_lo: Any, u_hi: Any, measurements: Sequence[Measu
         raise ValueError(f"tube: expected a Tube, got {tube!r}")
     t0 = time.perf_counter()
     x = ctc_deriv(tube, u_lo, u_hi, forward=True, backward=False)
-    res = ExplicitSlamResult(True, None, ThickMap(grid), x.widths())
-    m = res.map
+    m = ThickMap(grid)
+    res = ExplicitSlamResult(True, None, m, x.widths())
     total = float(np.sum(x.widths()))
     dug_lo, dug_hi = np.full_like(x.gate_lo, np.nan), np.full_like(x.gate_hi, np.nan)
     for it in range(cfg.max_iter):
@@ -547,7 +548,8 @@ def explicit_slam(tube: Tube, u_lo: Any, u_hi: Any, measurements: Sequence[Measu
 
 def mission_tube(record: MissionRecord, x0_lo: Any, x0_hi: Any) -> tuple[Tube, np.ndarray, np.ndarray, Tube]:
     """The initial tube, velocity bounds and heading tube of a record, as :func:`~.digslam.dig_slam` builds
-    them (compass and gyro fused, ``ẋ = v (cos ψ, sin ψ)``, Eq. 6.23).
+    them (compass and gyro fused, ``ẋ = R(ψ) v`` with the body-frame velocity ``v = (v_1, v_2)``, Eq. 3.59,
+    6.12, B.20: :func:`~.digslam.odometry_velocity`).
 
     Returns:
         ``(tube, u_lo, u_hi, heading)`` with ``[x](0) = X₀`` and entire gates elsewhere.
@@ -555,8 +557,7 @@ def mission_tube(record: MissionRecord, x0_lo: Any, x0_hi: Any) -> tuple[Tube, n
     t = record.t
     heading = heading_from_compass(t, record.heading[:, 0], record.heading[:, 1],
                                    record.yaw_rate[1:, 0], record.yaw_rate[1:, 1])  # fmt: skip
-    u_lo, u_hi = unicycle_velocity(record.speed[1:, 0], record.speed[1:, 1],
-                                   heading.slice_lo[:, 0], heading.slice_hi[:, 0])  # fmt: skip
+    u_lo, u_hi = odometry_velocity(record, heading)
     n = t.shape[0]
     g_lo, g_hi = np.full((n, 2), -np.inf), np.full((n, 2), np.inf)
     g_lo[0], g_hi[0] = np.asarray(x0_lo, np.float64), np.asarray(x0_hi, np.float64)

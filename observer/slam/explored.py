@@ -39,7 +39,8 @@ from digslam.observer.slam.grid import Grid
 from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA, UNKNOWN, ThickSep
 
 __all__ = ["explored_disks_grid", "explored_hypotheses", "explored_union", "SepExploredDisks",
-           "explored_disks_thick_sep", "explored_thick_sep", "check_tube", "check_interval"]  # fmt: skip
+           "explored_disks_thick_sep", "explored_thick_sep", "check_tube", "check_interval", "BLOCK", "codes",
+           "pair_test", "row_intervals"]  # fmt: skip
 
 #: (time, pair) budget of one block of the vectorised kernels
 BLOCK = 1 << 21
@@ -160,7 +161,9 @@ def row_intervals(grid: Grid, blo: np.ndarray, bhi: np.ndarray, r_lo: np.ndarray
     fys = axis_bounds(grid.ys[rows + 1], grid.ys[rows], blo[:, 1:2], bhi[:, 1:2])
     fxs = axis_bounds(grid.xs[cols], grid.xs[cols + 1], blo[:, 0:1], bhi[:, 0:1])
     valid_r, valid_c = np.arange(wr) < (r1 - r0)[:, None], np.arange(wc) < (c1 - c0)[:, None]
-    out = {}
+    out: dict[str, tuple[np.ndarray, ...]] = {}
+    keep: np.ufunc
+    drop: np.ufunc
     for test, (rd, which) in TESTS.items():
         r = r_lo if which == "lo" else r_hi
         if rd == "up":  # proved iff fy2_up < t with t = R²_down - fx2_up rounded down
@@ -212,7 +215,7 @@ def disk_masks(grid: Grid, pos_lo: np.ndarray, pos_hi: np.ndarray, r_lo: np.ndar
 
 
 def codes(clear: np.ndarray, dark: np.ndarray, upper: np.ndarray, outside: np.ndarray) -> np.ndarray:
-    """Thick codes of :mod:`.thick_sep` from the four proofs (penumbra = ``⊂ Z⁺`` and ``∩ Z⁻ = ∅``)."""
+    """Thick codes of :mod:`.thick.sep` from the four proofs (penumbra = ``⊂ Z⁺`` and ``∩ Z⁻ = ∅``)."""
     st = np.full(clear.shape, UNKNOWN, np.int8)
     st[upper & outside] = PENUMBRA
     st[clear] = CLEAR

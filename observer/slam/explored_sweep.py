@@ -52,7 +52,7 @@ def box_arc(dlo: np.ndarray, dhi: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
     l2, h2 = trig.atan2((-dhi[:, 1], -dlo[:, 1]), (-dhi[:, 0], -dlo[:, 0]))
     l2, h2 = rnd.add_down(l2, rnd.PI_DOWN), rnd.add_up(h2, rnd.PI_UP)  # bearing(-d) + π
     first = (h1 - l1) <= (h2 - l2)
-    zero = ((dlo <= 0) & (dhi >= 0)).all(1)
+    zero = np.asarray(((dlo <= 0) & (dhi >= 0)).all(1))
     return np.where(first, l1, l2), np.where(first, h1, h2), zero
 
 

@@ -8,7 +8,7 @@ without saying which ``m``. The constraint network (Eq. 3.70)
 
 is contracted with :func:`~.tube.ctc_deriv` on the heading and position tubes (i), the landmark-map
 contractor :class:`CtcLandmarks` (ii: the hull of the landmarks inside a box), forward-backward
-additions (iii, iv) and the minimal polar contractor :class:`~.polar_ctc.CtcPolar` (v). Iterating to
+additions (iii, iv) and the minimal polar contractor :class:`~.polar.ctc.CtcPolar` (v). Iterating to
 the fixpoint (:func:`localize`) solves the data association without any combinatorial search: a
 detection whose box ``[m_i]`` holds one landmark is associated, and since no contractor removes a
 consistent value, that landmark is the true one whenever the data bounds hold.
@@ -27,6 +27,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from digslam.observer.core import arith as A
 from digslam.observer.core.boxes import normalize_empty, validate_batch
@@ -53,7 +54,7 @@ class CtcLandmarks(Ctc):
 
     n = 2
 
-    def __init__(self, landmarks: object) -> None:
+    def __init__(self, landmarks: ArrayLike) -> None:
         m = np.array(landmarks, dtype=np.float64)
         if m.ndim != 2 or m.shape[1] != 2 or m.shape[0] < 1:
             raise ValueError(f"landmarks: expected shape (L, 2) with L >= 1, got {m.shape}")
@@ -114,12 +115,12 @@ class CtcLandmarks(Ctc):
             out_hi[rows, 1] = np.maximum.reduceat(pts[:, 1], start)
         return out_lo, out_hi
 
-    def count(self, lo: object, hi: object) -> np.ndarray:
+    def count(self, lo: ArrayLike, hi: ArrayLike) -> np.ndarray:
         """``(N,)`` number of landmarks inside each box."""
         blo, bhi = validate_batch(lo, hi, "boxes", 2)
         return np.bincount(self.pairs(blo, bhi)[0], minlength=blo.shape[0])
 
-    def unique(self, lo: object, hi: object) -> np.ndarray:
+    def unique(self, lo: ArrayLike, hi: ArrayLike) -> np.ndarray:
         """``(N,)`` index into ``landmarks`` of the only landmark inside each box, ``-1`` when 0 or >= 2."""
         blo, bhi = validate_batch(lo, hi, "boxes", 2)
         box, idx = self.pairs(blo, bhi)
@@ -239,7 +240,7 @@ class Localization:
         return next((h.iteration for h in self.history if h.unique == d), None)
 
 
-def _intervals(name: str, lo: object, hi: object, size: int | None = None) -> Pair:
+def _intervals(name: str, lo: ArrayLike, hi: ArrayLike, size: int | None = None) -> Pair:
     a, b = np.array(lo, dtype=np.float64).reshape(-1), np.array(hi, dtype=np.float64).reshape(-1)
     if a.shape != b.shape or (size is not None and a.size != size):
         want = f"({size},)" if size is not None else "one shape"
@@ -256,10 +257,20 @@ def _moved(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.nan_to_num(d, nan=np.inf).max())
 
 
-def localize(t: object, v: tuple[object, object], omega: tuple[object, object], psi0: tuple[float, float],
-             k: object, rho: tuple[object, object], phi: tuple[object, object], landmarks: object,
-             max_iter: int = 50, passes: int = 2, tol: float = 1e-3, disjunctive: bool = True
-             ) -> Localization:  # fmt: skip
+def localize(
+    t: ArrayLike,
+    v: tuple[ArrayLike, ArrayLike],
+    omega: tuple[ArrayLike, ArrayLike],
+    psi0: tuple[float, float],
+    k: ArrayLike,
+    rho: tuple[ArrayLike, ArrayLike],
+    phi: tuple[ArrayLike, ArrayLike],
+    landmarks: ArrayLike,
+    max_iter: int = 50,
+    passes: int = 2,
+    tol: float = 1e-3,
+    disjunctive: bool = True,
+) -> Localization:
     """Fixpoint of the network Eq. 3.70 from an unknown start ``p(t_0) ∈ ℝ²`` (thesis §3.4.3.4).
 
     Each iteration contracts every detection (:func:`contract_detections`), intersects the results

@@ -11,9 +11,12 @@ echoing cone's interval contains the distance from the robot centre to the neare
 its sector.
 
 Data contract (what the observers rely on): ``heading[k]`` bounds the true heading at ``t_k`` and
-``range[k]`` the exact distances from the pose at ``t_k``; ``speed[k]`` and ``yaw_rate[k]`` bound the true
-speed and yaw rate over the WHOLE slice ``[t_{k-1}, t_k]`` that ends at ``t_k`` (odometry integrated over
-the step just ended, not an instantaneous value); record 0's odometry bounds nothing the observers use.
+``range[k]`` the exact distances from the pose at ``t_k``; ``speed[k]``, ``lateral[k]`` and ``yaw_rate[k]``
+bound the true body-frame velocity ``v = (v_1, v_2)`` (forward, leftward; a Doppler velocity log) and yaw
+rate at every instant of the WHOLE slice ``[t_{k-1}, t_k]`` that ends at ``t_k`` (not an instantaneous
+value); record 0's odometry bounds nothing the observers use. The position then obeys ``x' = R(psi) v``
+(Eq. 3.59, 6.12, B.20). A unicycle record (a robot that cannot slip sideways) has ``lateral = [0, 0]``,
+the default: records saved before the field existed load with it.
 
 This module needs numpy only, so the observer can read missions without importing the simulator.
 
@@ -33,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 _PREFIX = "record_"
-_FLOAT_FIELDS = ("t", "speed", "yaw_rate", "heading", "alpha", "gamma", "r_max", "range")
+_FLOAT_FIELDS = ("t", "speed", "yaw_rate", "heading", "alpha", "gamma", "r_max", "range", "lateral")
 
 
 @dataclass(eq=False)
@@ -42,7 +45,7 @@ class MissionRecord:
 
     Attributes:
         t: Time of the measurement (s).
-        speed: Odometry forward speed interval ``[lo, hi]`` (m/s), shape ``(..., 2)``.
+        speed: Forward body-frame velocity ``v_1`` interval ``[lo, hi]`` (m/s), shape ``(..., 2)``.
         yaw_rate: Odometry yaw-rate interval (rad/s), shape ``(..., 2)``.
         heading: Compass heading interval (rad, continuous, not wrapped), shape ``(..., 2)``.
         alpha: Cone directions relative to the heading (rad), shape ``(..., n)``.
@@ -51,6 +54,8 @@ class MissionRecord:
         range: Range intervals (m), shape ``(..., n, 2)``; ``[r_max, inf]`` where ``no_echo``.
         no_echo: True where nothing lies in the cone up to ``r_max``, shape ``(..., n)``.
         outlier: True where the reading is an injected outlier (its interval may miss the truth).
+        lateral: Leftward body-frame velocity ``v_2`` interval (m/s), shape ``(..., 2)``; default ``[0, 0]``
+            (a unicycle).
     """
 
     t: np.ndarray
@@ -63,9 +68,12 @@ class MissionRecord:
     range: np.ndarray
     no_echo: np.ndarray
     outlier: np.ndarray
+    lateral: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         d = self.__dict__
+        if d["lateral"] is None:
+            d["lateral"] = np.zeros(np.shape(d["speed"]))
         for name in _FLOAT_FIELDS:
             d[name] = np.asarray(d[name], dtype=np.float64)
         d["no_echo"] = np.asarray(d["no_echo"], dtype=bool)
@@ -74,7 +82,7 @@ class MissionRecord:
         n = self.alpha.shape[len(lead) :]
         if len(n) != 1:
             raise ValueError(f"alpha: expected shape {lead}+(n,), got {self.alpha.shape}")
-        for name in ("speed", "yaw_rate", "heading"):
+        for name in ("speed", "yaw_rate", "heading", "lateral"):
             if getattr(self, name).shape != lead + (2,):
                 raise ValueError(f"{name}: expected shape {lead + (2,)}, got {getattr(self, name).shape}")
         for name in ("gamma", "r_max", "no_echo", "outlier"):
@@ -86,7 +94,7 @@ class MissionRecord:
 
     def _check_bounds(self) -> None:
         """Reject intervals with a NaN or ``lo > hi``, non-finite times and bad cone geometry."""
-        for name in ("speed", "yaw_rate", "heading", "range"):
+        for name in ("speed", "yaw_rate", "heading", "range", "lateral"):
             v = getattr(self, name)
             bad = np.isnan(v).any(axis=-1) | (v[..., 0] > v[..., 1])
             if bad.any():
@@ -148,10 +156,13 @@ class MissionRecord:
     def from_arrays(
         arrays: dict[str, np.ndarray] | np.lib.npyio.NpzFile, prefix: str = _PREFIX
     ) -> MissionRecord:
-        """Inverse of :meth:`to_arrays`; raises ``KeyError`` naming a missing field."""
+        """Inverse of :meth:`to_arrays`; raises ``KeyError`` naming a missing field (``lateral``, absent
+        from records saved before it existed, defaults to ``[0, 0]``)."""
         out = {}
         for f in fields(MissionRecord):
             key = prefix + f.name
+            if key not in arrays and f.name == "lateral":
+                continue
             if key not in arrays:
                 raise KeyError(f"{key}: missing from the record arrays")
             out[f.name] = np.asarray(arrays[key])
@@ -159,7 +170,7 @@ class MissionRecord:
 
     def save_npz(self, path: str | Path) -> None:
         """Save to a ``.npz`` file."""
-        np.savez(path, **self.to_arrays())
+        np.savez(path, **self.to_arrays())  # type: ignore[arg-type]  # numpy's stub: **arrays could fill allow_pickle
 
     @staticmethod
     def load_npz(path: str | Path) -> MissionRecord:

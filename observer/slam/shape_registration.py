@@ -34,7 +34,7 @@ import numpy as np
 from digslam.observer.core import rounding as rnd
 from digslam.observer.core.boxes import empty_rows
 from digslam.observer.core.types import Batch
-from digslam.observer.sets.projection import _one_box
+from digslam.observer.sets.projection import bounded_box
 from digslam.observer.sets.sep_image import SepImage
 from digslam.observer.sets.separators import Sep
 from digslam.observer.thick.carving import ctc_param_equal, param_hull
@@ -294,7 +294,7 @@ class SepTranslationInclusion(Sep):
         free = (ra >= 0) & (rb < self.bh) & (ca >= 0) & (cb < self.bw)
         free &= self._count(self.sat_in, ra, rb, ca, cb) == 0
         infeasible |= free.any(axis=1).reshape(-1, n).any(axis=0)
-        return infeasible, feasible & ~infeasible
+        return np.asarray(infeasible), np.asarray(feasible & ~infeasible)
 
     def separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
         live = ~empty_rows(lo, hi)
@@ -356,7 +356,7 @@ def register_translation(a: ThickImage, b: ThickImage, p_box: Any, eps_p: float,
     """
     if not isinstance(a, ThickImage) or not isinstance(b, ThickImage):
         raise ValueError(f"a: expected two ThickImage, got {type(a).__name__} and {type(b).__name__}")
-    _one_box(p_box, "p_box")
+    bounded_box(p_box, "p_box")
     if method == "image":
         seps = [SepTranslationInclusion(a, b, 1, samples), SepTranslationInclusion(b, a, -1, samples)]
         return param_hull(seps, p_box, eps_p, presplit)

@@ -29,6 +29,7 @@ from .interval import (
     TRUE,
     ThickIntervalArray,
     thin,
+    tri_state,
 )
 from .inversion import (
     SepFixedParam,
@@ -107,4 +108,5 @@ __all__ = [
     "thick_sivia",
     "thick_sivia_subset_supset",
     "thin",
+    "tri_state",
 ]

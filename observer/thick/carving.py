@@ -32,7 +32,7 @@ import numpy as np
 from digslam.observer.core.boxes import bisect, empty_rows, normalize_empty, width_inf
 from digslam.observer.core.interval import IntervalArray
 from digslam.observer.core.types import Batch
-from digslam.observer.sets.projection import _one_box
+from digslam.observer.sets.projection import bounded_box
 from digslam.observer.sets.registration import sep_inclusion, sep_intersection, transform_function
 from digslam.observer.sets.separators import Sep, inter_batch
 from digslam.observer.sets.transforms import Transform
@@ -74,7 +74,7 @@ def param_hull(sep: Sep | Sequence[Sep], p_box: Any, eps: float, presplit: int =
     seps = [sep] if isinstance(sep, Sep) else list(sep)
     if not seps or not all(isinstance(x, Sep) for x in seps):
         raise ValueError(f"sep: expected a Sep or a non-empty sequence of Sep, got {sep!r}")
-    plo, phi = _one_box(p_box, "p_box")
+    plo, phi = bounded_box(p_box, "p_box")
     if not (isinstance(eps, (int, float, np.floating)) and np.isfinite(eps) and eps > 0):
         raise ValueError(f"eps: must be a positive finite number, got {eps!r}")
     lo, hi = plo[None].copy(), phi[None].copy()
@@ -101,7 +101,8 @@ def param_hull(sep: Sep | Sequence[Sep], p_box: Any, eps: float, presplit: int =
                     shi[:, k] = xin[0][m, k]
                 else:
                     slo[:, k] = xin[1][m, k]
-                parts_lo.append(slo), parts_hi.append(shi)
+                parts_lo.append(slo)
+                parts_hi.append(shi)
         cat_lo, cat_hi = np.concatenate(parts_lo), np.concatenate(parts_hi)
         if cat_lo.shape[0]:
             h_lo, h_hi = np.minimum(h_lo, cat_lo.min(axis=0)), np.maximum(h_hi, cat_hi.max(axis=0))
@@ -208,7 +209,7 @@ def ctc_image_param(a: ThickSep, b: ThickSep, f: Any, f_inv: Any, p_box: Any, *,
         a, b: ``[A]``, ``[B]`` on ``Rⁿ``; f, f_inv: ``f(a, p)`` and ``f_inv(b, p) = f_p⁻¹(b)``.
         p_box: the (contracted) parameter box; n: the dimension; eps: projection width over ``[p]``.
     """
-    plo, _ = _one_box(p_box, "p_box")
+    plo, _ = bounded_box(p_box, "p_box")
     q = plo.size if q is None else q
     fz, gz = transform_function(f, n, q, n), transform_function(f_inv, n, q, n)
     pre_b = thick_inverse_proj(fz, b.lower, b.upper, p_box, n=n, eps=eps)  # F⁻¹([B])
@@ -251,7 +252,7 @@ def srac(f: Any, f_inv: Any, p_box: Any, a: ThickSep, b: ThickSep, a_box: Any, b
     p = ctc_param_equal(p_box, a, b, f, f_inv, a_box, b_box, eps, eps_p, presplit, **proj_kw)
     if empty_rows(p[0][None], p[1][None])[0]:
         return SRACResult(p, a, b, True)
-    n = _one_box(a_box, "a_box")[0].size
+    n = bounded_box(a_box, "a_box")[0].size
     a2, b2 = ctc_image_param(a, b, f, f_inv, _box(p), n=n, eps=eps_p if eps_carve is None else eps_carve,
                              q=p[0].size)  # fmt: skip
     return SRACResult(p, a2, b2, False)

@@ -47,7 +47,7 @@ class ThickFunction:
             for a thick function with values ``≥ 0``. Its bounds ``A`` approximate the exact range bounds
             ``e ≥ 0`` with ``A ≤ e·(1+u)ᵏ + η`` for the lower ends ``lb[f⁻]``, ``lb[f⁺]`` and
             ``A ≥ e·(1−u)ᵏ − η`` for the upper ends ``ub[f⁻]``, ``ub[f⁺]`` (``u = 2⁻⁵³``, ``η = 2⁻¹⁰⁷⁰``;
-            ``+inf`` only where ``e`` exceeds the largest float). :class:`~.thick_sivia.ThickInverse`
+            ``+inf`` only where ``e`` exceeds the largest float). :class:`~.sivia.ThickInverse`
             then moves the thresholds of ``Y`` once instead of rounding every bound (a forward error
             bound, Higham, *Accuracy and Stability of Numerical Algorithms*, §3.1).
     """
@@ -194,6 +194,9 @@ class ThickFunction:
 
         def approx(lo: np.ndarray, hi: np.ndarray) -> tuple[tuple[np.ndarray, ...], int]:
             acc: list[np.ndarray] = []
+            cj: float | np.ndarray
+            dj: float | np.ndarray
+            hj: float | np.ndarray
             one = c.shape[0] == 1  # one uncertain point: 1-d columns against scalars (faster)
             for j in range(n):  # loop over the coordinates, each on the whole batch (N, K)
                 if one:
@@ -217,6 +220,7 @@ class ThickFunction:
         lo, hi = validate_batch(np.asarray(lo, float), np.asarray(hi, float), "boxes", self.n)
         if self._evaluator is not None:
             return self._evaluator(lo, hi)
+        assert self.f_minus is not None and self.f_plus is not None  # __init__: both, or an evaluator
         a, b = self.f_minus.eval((lo, hi)), self.f_plus.eval((lo, hi))
         return ThickIntervalArray(a.lo, a.hi, b.lo, b.hi, check=False)
 

@@ -23,7 +23,9 @@ FALSE = np.int8(0)
 UNKNOWN = np.int8(-1)
 
 
-def _tri(true: np.ndarray, false: np.ndarray) -> np.ndarray:
+def tri_state(true: np.ndarray, false: np.ndarray) -> np.ndarray:
+    """The int8 tri-state of two masks: :data:`TRUE` where ``true``, else :data:`FALSE` where ``false``,
+    else :data:`UNKNOWN`."""
     out = np.full(np.shape(true), UNKNOWN, dtype=np.int8)
     out[np.asarray(false)] = FALSE
     out[np.asarray(true)] = TRUE
@@ -73,14 +75,6 @@ class ThickIntervalArray:
             (float(self.hi_lo.ravel()[0]), float(self.hi_hi.ravel()[0])),
         )
 
-    def subset(self) -> tuple[np.ndarray, np.ndarray]:
-        """Smallest member ``[x⁻ sup, x⁺ inf]`` as ``(lo, hi)`` (empty where lo > hi)."""
-        return self.lo_hi, self.hi_lo
-
-    def supset(self) -> tuple[np.ndarray, np.ndarray]:
-        """Largest member ``[x⁻ inf, x⁺ sup]`` as ``(lo, hi)``."""
-        return self.lo_lo, self.hi_hi
-
     # Arithmetic on the bounds (Eq. A.16): monotonic operations act bound-wise.
     def __add__(self, o: ThickIntervalArray) -> ThickIntervalArray:
         """``⟦a⁻ + b⁻, a⁺ + b⁺⟧`` with outward rounding."""
@@ -107,7 +101,7 @@ class ThickIntervalArray:
         """Tri-state of ``[a] ⊂ [b]`` for all ``[a] ∈ ⟦a⟧, [b] ∈ ⟦b⟧`` (Prop. A.1)."""
         true = (self.lo_lo >= o.lo_hi) & (self.hi_hi <= o.hi_lo)
         false = (self.lo_hi < o.lo_lo) | (self.hi_lo > o.hi_hi)
-        return _tri(true, false)
+        return tri_state(true, false)
 
     def not_subset_of(self, o: ThickIntervalArray) -> np.ndarray:
         """Tri-state of ``[a] ⊄ [b]`` for all members (negation of :meth:`subset_of`)."""
@@ -117,7 +111,7 @@ class ThickIntervalArray:
         """Tri-state of ``[a] ∩ [b] ≠ ∅`` for all members (Prop. A.2, Example A.2)."""
         true = (self.lo_hi <= o.hi_lo) & (o.lo_hi <= self.hi_lo)
         false = (self.lo_lo > o.hi_hi) | (o.lo_lo > self.hi_hi)
-        return _tri(true, false)
+        return tri_state(true, false)
 
     def disjoint(self, o: ThickIntervalArray) -> np.ndarray:
         """Tri-state of ``[a] ∩ [b] = ∅`` for all members (negation of :meth:`overlaps`)."""
@@ -142,4 +136,5 @@ __all__ = [
     "ThickIntervalArray",
     "UNKNOWN",
     "thin",
+    "tri_state",
 ]

@@ -1,7 +1,7 @@
 """Images, Cartesian products and Minkowski sums of thick sets (thesis §5.2.3, Eq. 5.10, 5.12, 5.13).
 
 Each operation is monotone for ``⊂``, so it acts on the two bounds of ``[X] = [X⁻, X⁺]`` (Eq. 5.7) and
-the result is a :class:`~.thick_sep.ThickSep` built on the classical separators of the bounds:
+the result is a :class:`~.sep.ThickSep` built on the classical separators of the bounds:
 
 * image by a bijection ``f``: ``f([A]) = [f(A⁻), f(A⁺)]`` (Eq. 5.13) with :class:`~.transforms.SepTransform`;
 * image by a bijection ``f_p`` with an uncertain ``p ∈ [p]``: ``[∩_p f_p(A⁻), ∪_p f_p(A⁺)]``, the
@@ -26,9 +26,8 @@ from __future__ import annotations
 from typing import Any
 
 from digslam.observer.sets.minkowski import SepMinkowskiSum
-from digslam.observer.sets.projection import SepOnDims, _one_box
-from digslam.observer.sets.registration import Transform as ParamTransform
-from digslam.observer.sets.registration import transform_function
+from digslam.observer.sets.projection import SepOnDims, bounded_box
+from digslam.observer.sets.registration import ParamTransform, transform_function
 from digslam.observer.sets.separators import Sep, SepInter
 from digslam.observer.sets.transforms import SepTransform, Transform
 from digslam.observer.thick.inversion import thick_inverse_proj
@@ -78,7 +77,7 @@ def thick_image_param(a: ThickSep, f_inv: ParamTransform | Any, p_box: Any, *, n
         ValueError: on a bad parameter box or a transform of the wrong dimension.
     """
     _check(a, "a")
-    plo, _ = _one_box(p_box, "p_box")
+    plo, _ = bounded_box(p_box, "p_box")
     q = plo.size if q is None else q
     if plo.size != q:
         raise ValueError(f"p_box: {plo.size} intervals for a parameter of dimension {q}")

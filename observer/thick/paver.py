@@ -28,7 +28,7 @@ from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
 class ThickTest(Protocol):
     """What :func:`thick_pave` needs: ``n`` and ``classify(lo, hi)`` returning ``int8`` codes
     (:data:`CLEAR`, :data:`PENUMBRA`, :data:`DARK`, ``0`` unknown), e.g. a
-    :class:`~.thick_sep.ThickSep` or a :class:`~.thick_sivia.ThickInverse`."""
+    :class:`~.sep.ThickSep` or a :class:`~.sivia.ThickInverse`."""
 
     n: int | None
 
@@ -69,11 +69,6 @@ class ThickPaving:
     def boundary_area(self) -> float:
         """Volume left undetermined."""
         return self._area(self.boundary)
-
-    @property
-    def undetermined(self) -> Batch:
-        """The undetermined boxes (same as :attr:`boundary`)."""
-        return self.boundary
 
     def draw(self, ax: Any = None, frame: Any = None, title: str | None = None,
              linewidth: float = 0.1) -> Any:  # fmt: skip

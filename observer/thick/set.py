@@ -1,6 +1,6 @@
 """Contractors on thick sets (thesis §5.5.1–5.5.2, Eq. 5.44–5.46), acting on their separators.
 
-A thick set ``[X] = [X⁻, X⁺]`` is represented by its :class:`~.thick_sep.ThickSep`: the pair of
+A thick set ``[X] = [X⁻, X⁺]`` is represented by its :class:`~.sep.ThickSep`: the pair of
 separators of ``X⁻`` and ``X⁺``; the set operations of Eq. 5.8–5.17 are its operators (``&``, ``|``,
 ``~``, ``-``, ``meet``, ``join``). Contracting a thick set moves its bounds inwards (Fig. 5.8):
 

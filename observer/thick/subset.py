@@ -18,7 +18,7 @@ True
 >>> bool(SubsetSupsetArray.from_thick(b).overlaps([1.0], [5.0])[0] == UNKNOWN)
 True
 
-:class:`ThickInverseSubsetSupset` is :class:`~.thick_sivia.ThickInverse` (Algorithm A.2) with the four
+:class:`ThickInverseSubsetSupset` is :class:`~.sivia.ThickInverse` (Algorithm A.2) with the four
 tests of Prop. A.1 taken on the subset–supset representation of ``⟦f⟧([x])`` (the centre of Fig. A.8);
 :func:`thick_sivia_subset_supset` paves with it.
 """
@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from digslam.observer.thick.function import ThickFunction
-from digslam.observer.thick.interval import FALSE, TRUE, ThickIntervalArray, _tri
+from digslam.observer.thick.interval import FALSE, TRUE, ThickIntervalArray, tri_state
 from digslam.observer.thick.paver import ThickPaving, thick_pave
 from digslam.observer.thick.sivia import ThickInverse
 
@@ -76,7 +76,7 @@ class SubsetSupsetArray:
         true = (self.sup_lo >= b_lo) & (self.sup_hi <= b_hi)
         disjoint = (self.sup_hi < b_lo) | (self.sup_lo > b_hi)
         false = np.where(self.sub_empty, disjoint, (self.sub_lo < b_lo) | (self.sub_hi > b_hi))
-        return _tri(true, false)
+        return tri_state(true, false)
 
     def overlaps(self, b_lo: Any, b_hi: Any) -> np.ndarray:
         """Tri-state of ``[x] ∩ [b] ≠ ∅`` for every member (Prop. A.1 iii–iv on the representation).
@@ -89,13 +89,13 @@ class SubsetSupsetArray:
         inside = (self.sup_lo >= b_lo) & (self.sup_hi <= b_hi)
         true = np.where(self.sub_empty, inside, meets_sub)
         false = (self.sup_hi < b_lo) | (self.sup_lo > b_hi)
-        return _tri(true, false)
+        return tri_state(true, false)
 
 
 class ThickInverseSubsetSupset(ThickInverse):
     """Algorithm A.2's tests on the subset–supset representation of ``⟦f⟧([x])`` (Fig. A.8, centre).
 
-    Same arguments and codes as :class:`~.thick_sivia.ThickInverse`; the enclosures always come from
+    Same arguments and codes as :class:`~.sivia.ThickInverse`; the enclosures always come from
     the outward-rounded ``f.eval`` and the comparisons are exact, so the claims hold in floating point.
     Clear and dark boxes are the same as with lower–upper bounds (they only use ``[x^⊃]``); the
     penumbra is proved for fewer boxes, none while ``[x^⊂]`` is empty and ``[x^⊃]`` straddles a bound.
@@ -121,7 +121,7 @@ def thick_sivia_subset_supset(x0: Any, f: ThickFunction, y_lower: Any, y_upper: 
                               max_boxes: int = 20_000_000) -> ThickPaving:  # fmt: skip
     """ThickSivia (Algorithm A.2) with subset–supset thick intervals (Eq. A.15; Fig. A.8, centre).
 
-    Args and result as :func:`~.thick_sivia.thick_sivia` (Theorem A.2 holds: the representation
+    Args and result as :func:`~.sivia.thick_sivia` (Theorem A.2 holds: the representation
     contains every member of ``⟦f⟧([x])``).
     """
     return thick_pave(x0, ThickInverseSubsetSupset(f, y_lower, y_upper), eps, max_boxes)

@@ -230,6 +230,12 @@ def unicycle_velocity(speed_lo: object, speed_hi: object, heading_lo: object, he
 def body_velocity(v_lo: object, v_hi: object, heading_lo: object, heading_hi: object) -> Pair:
     """``ẋ = R(ψ)·v`` (Eq. 3.59, 6.12, B.20) with ``v = (v_1, v_2)`` in the robot frame, per slice.
 
+    ``[u_k] ⊃ {R(ψ) v : v ∈ [v_k], ψ ∈ [ψ_k]}`` by the natural inclusion function
+    ``(v_1 cos ψ - v_2 sin ψ, v_1 sin ψ + v_2 cos ψ)``, outward rounded. A row with ``[v_2] = [0, 0]`` (a
+    unicycle, which cannot slip sideways) is :func:`unicycle_velocity` to the bit: ``- [0, 0]·sin ψ`` is
+    exactly zero, and dropping it keeps the signs of zero bounds (``x - (-0.0)`` turns a ``-0.0`` into
+    ``+0.0``), so a unicycle record gives the same tube as before the lateral velocity existed.
+
     Args:
         v_lo, v_hi: ``(T, 2)`` body-frame velocity over each slice.
         heading_lo, heading_hi: ``(T,)`` heading over each slice.
@@ -246,8 +252,16 @@ def body_velocity(v_lo: object, v_hi: object, heading_lo: object, heading_hi: ob
     if psi[0].shape != v1[0].shape:
         raise ValueError(f"heading: shape {psi[0].shape} differs from v's {vl.shape}")
     c, s = trig.cos(psi), trig.sin(psi)
-    u1 = arith.sub(arith.mul(v1, c), arith.mul(v2, s))
-    u2 = arith.add(arith.mul(v1, s), arith.mul(v2, c))
+    a1, a2 = arith.mul(v1, c), arith.mul(v1, s)  # the unicycle terms (Eq. 6.23)
+    uni = (v2[0] == 0) & (v2[1] == 0)
+    if uni.all():
+        u1, u2 = a1, a2
+    else:
+        u1 = arith.sub(a1, arith.mul(v2, s))
+        u2 = arith.add(a2, arith.mul(v2, c))
+        if uni.any():
+            u1 = (np.where(uni, a1[0], u1[0]), np.where(uni, a1[1], u1[1]))
+            u2 = (np.where(uni, a2[0], u2[0]), np.where(uni, a2[1], u2[1]))
     return np.stack([u1[0], u2[0]], axis=1), np.stack([u1[1], u2[1]], axis=1)
 
 

@@ -3,7 +3,7 @@
 A tube ``[x](·)`` is an interval of trajectories. Here it is sliced over a time grid
 ``t_0 < ... < t_T``: a gate ``[x](t_k)`` at each grid time and a slice, the envelope of ``[x](τ)`` for
 ``τ ∈ [t_k, t_{k+1}]`` (closed, so a slice holds both of its gates). :func:`ctc_deriv` contracts a tube
-with ``ẋ = u``, ``u ∈ [u]`` (the kernels and the soundness proof are in :mod:`.tube_ctc`), which
+with ``ẋ = u``, ``u ∈ [u]`` (the kernels and the soundness proof are in :mod:`.ctc`), which
 propagates a contraction made at one time (a position fix, a registration) to the whole trajectory.
 :func:`heading_from_gyro`, :func:`heading_from_compass`, :func:`unicycle_velocity` and
 :func:`dead_reckoning` build the guaranteed dead reckoning of Eq. 3.59, 6.12, 6.23 and B.20.
@@ -22,6 +22,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from digslam.observer.core.boxes import width_inf
 from digslam.observer.core.types import Pair
@@ -33,7 +34,7 @@ __all__ = ["Tube", "ctc_deriv", "unicycle_velocity", "body_velocity", "heading_f
 _INF = np.inf
 
 
-def _boxes(name: str, lo: object, hi: object, rows: int, n: int | None = None) -> Pair:
+def _boxes(name: str, lo: ArrayLike, hi: ArrayLike, rows: int, n: int | None = None) -> Pair:
     """``(rows, n)`` float arrays (a 1-d input is one coordinate); empty rows normalised to ``[+∞, -∞]``."""
     lo_a, hi_a = np.array(lo, dtype=np.float64), np.array(hi, dtype=np.float64)
     if lo_a.ndim == 1 and lo_a.shape == hi_a.shape:
@@ -74,8 +75,8 @@ class Tube:
 
     inconsistent_at: int | None = None
 
-    def __init__(self, t: object, gate_lo: object, gate_hi: object,
-                 slice_lo: object = None, slice_hi: object = None) -> None:  # fmt: skip
+    def __init__(self, t: ArrayLike, gate_lo: ArrayLike, gate_hi: ArrayLike,
+                 slice_lo: ArrayLike | None = None, slice_hi: ArrayLike | None = None) -> None:  # fmt: skip
         ta = np.array(t, dtype=np.float64)
         if ta.ndim != 1 or ta.size < 2:
             raise ValueError(f"t: expected a 1-d array of at least 2 times, got shape {ta.shape}")
@@ -86,11 +87,11 @@ class Tube:
         self.t = ta
         self.gate_lo, self.gate_hi = _boxes("gate", gate_lo, gate_hi, ta.size)
         n = self.gate_lo.shape[1]
-        if (slice_lo is None) != (slice_hi is None):
-            raise ValueError("slice_lo: give both slice_lo and slice_hi, or neither")
-        if slice_lo is None:
+        if slice_lo is None and slice_hi is None:
             self.slice_lo = np.minimum(self.gate_lo[:-1], self.gate_lo[1:])
             self.slice_hi = np.maximum(self.gate_hi[:-1], self.gate_hi[1:])
+        elif slice_lo is None or slice_hi is None:
+            raise ValueError("slice_lo: give both slice_lo and slice_hi, or neither")
         else:
             self.slice_lo, self.slice_hi = _boxes("slice", slice_lo, slice_hi, ta.size - 1, n)
 
@@ -103,7 +104,7 @@ class Tube:
         return x
 
     @classmethod
-    def entire(cls, t: object, n: int) -> Tube:
+    def entire(cls, t: ArrayLike, n: int) -> Tube:
         """The tube ``(-∞, +∞)ⁿ`` at every time."""
         size = np.size(t)
         if int(n) < 1:
@@ -148,7 +149,7 @@ class Tube:
         on_gate = self.t[k] == ts
         return np.where(on_gate, k, np.minimum(k, self.T - 1)), on_gate
 
-    def __call__(self, t: object) -> Pair:
+    def __call__(self, t: ArrayLike) -> Pair:
         """Box at time ``t`` (the gate at a grid time, else the slice holding ``t``); ``(n,)`` for a
         scalar time, ``(m, n)`` for ``m`` times."""
         ts = np.asarray(t, dtype=np.float64)
@@ -184,7 +185,7 @@ class Tube:
         """True when some gate or slice is empty: no trajectory lies in the tube (inconsistent data)."""
         return self.first_empty() is not None
 
-    def contains(self, t_samples: object, x_samples: object) -> np.ndarray:
+    def contains(self, t_samples: ArrayLike, x_samples: ArrayLike) -> np.ndarray:
         """``(m,)`` mask: whether sample ``x(t_i)`` of a trajectory lies in the tube's box at ``t_i``."""
         ts = np.asarray(t_samples, dtype=np.float64).reshape(-1)
         xs = np.asarray(x_samples, dtype=np.float64).reshape(ts.size, -1)
@@ -215,12 +216,12 @@ def _empty_like(x: Tube, at: int | None) -> Tube:
     return e
 
 
-def ctc_deriv(x: Tube, u_lo: object, u_hi: object, forward: bool = True, backward: bool = True) -> Tube:
+def ctc_deriv(x: Tube, u_lo: ArrayLike, u_hi: ArrayLike, forward: bool = True, backward: bool = True) -> Tube:
     """``C_d/dt`` for ``ẋ = u`` with ``u(τ) ∈ [u_k]`` for ``τ`` in slice ``k`` (Eq. 2.76, Remark 2.12).
 
     Gates ``x_{k+1} &= x_k + dt_k[u_k]`` (forward), ``x_k &= x_{k+1} - dt_k[u_k]`` (backward), slices
     ``&= (x_k + [0,dt_k][u_k]) & (x_{k+1} - [0,dt_k][u_k])``, gates ``&=`` both adjacent slices; outward
-    rounded, vectorised over time (max-plus closed form, proof in :mod:`.tube_ctc`).
+    rounded, vectorised over time (max-plus closed form, proof in :mod:`.ctc`).
 
     Args:
         x: the tube to contract (not modified).
@@ -246,13 +247,13 @@ def ctc_deriv(x: Tube, u_lo: object, u_hi: object, forward: bool = True, backwar
     return _empty_like(x, bad) if bad is not None else Tube._trusted(x.t, glo, ghi, slo, shi)
 
 
-def _scalar(name: str, lo: object, hi: object) -> Pair:
+def _scalar(name: str, lo: ArrayLike, hi: ArrayLike) -> Pair:
     return _boxes(name, np.reshape(np.asarray(lo, dtype=np.float64), (1, -1)),
                   np.reshape(np.asarray(hi, dtype=np.float64), (1, -1)), 1)  # fmt: skip
 
 
 def heading_from_gyro(
-    t: object, psi0_lo: float, psi0_hi: float, yaw_rate_lo: object, yaw_rate_hi: object
+    t: ArrayLike, psi0_lo: float, psi0_hi: float, yaw_rate_lo: ArrayLike, yaw_rate_hi: ArrayLike
 ) -> Tube:
     """1-d heading tube ``ψ̇ = ω``, ``ω ∈ [ω_k]`` on slice ``k``, from ``ψ(t_0) ∈ [ψ0]`` (unwrapped angle).
 
@@ -265,8 +266,13 @@ def heading_from_gyro(
     return ctc_deriv(x, yaw_rate_lo, yaw_rate_hi, forward=True, backward=False)
 
 
-def heading_from_compass(t: object, heading_lo: object, heading_hi: object,
-                         yaw_rate_lo: object = None, yaw_rate_hi: object = None) -> Tube:  # fmt: skip
+def heading_from_compass(
+    t: ArrayLike,
+    heading_lo: ArrayLike,
+    heading_hi: ArrayLike,
+    yaw_rate_lo: ArrayLike | None = None,
+    yaw_rate_hi: ArrayLike | None = None,
+) -> Tube:
     """1-d heading tube from compass intervals at the gates (``(T+1,)``, unwrapped), fused with a gyro.
 
     Without a yaw rate the slices are the hull of their two gates (an assumption: the heading stays
@@ -278,13 +284,15 @@ def heading_from_compass(t: object, heading_lo: object, heading_hi: object,
     x = Tube(t, heading_lo, heading_hi)
     if x.n != 1:
         raise ValueError(f"heading_lo: expected shape (T+1,), got {np.shape(heading_lo)}")
-    if yaw_rate_lo is None:
+    if yaw_rate_lo is None or yaw_rate_hi is None:
         return x
     full = np.full((x.T, 1), _INF)
     return ctc_deriv(Tube(t, x.gate_lo, x.gate_hi, -full, full), yaw_rate_lo, yaw_rate_hi)
 
 
-def dead_reckoning(t: object, x0_lo: object, x0_hi: object, u_lo: object, u_hi: object) -> Tube:
+def dead_reckoning(
+    t: ArrayLike, x0_lo: ArrayLike, x0_hi: ArrayLike, u_lo: ArrayLike, u_hi: ArrayLike
+) -> Tube:
     """Guaranteed integration of ``ẋ = u`` from ``x(t_0) ∈ [x0]`` (``(n,)``): :func:`ctc_deriv` forward."""
     x0 = _scalar("x0", x0_lo, x0_hi)
     x = Tube.entire(t, x0[0].shape[1])

@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+import ast
 import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
+from digslam.agents.cli import commands
 from digslam.agents.cli import main as cli
+from digslam.agents.learning import models
 from digslam.envs.explore.episode import Episode
 
 SUBCOMMANDS = ["demo", "train", "evaluate", "record", "replay", "benchmark"]
@@ -34,6 +38,37 @@ def test_console_script_and_module_entry_points() -> None:
     cmd = [exe, "--help"] if exe else [sys.executable, "-m", "digslam.agents.cli.main", "--help"]
     res = subprocess.run(cmd, capture_output=True, text=True, timeout=60)
     assert res.returncode == 0 and "demo" in res.stdout and "usage: digslam" in res.stdout
+    cmd = [sys.executable, "-W", "error::RuntimeWarning", "-m", "digslam.agents.cli.main", "--help"]
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=60)  # no "found in sys.modules" warning
+    assert res.returncode == 0 and "usage: digslam" in res.stdout and not res.stderr
+
+
+def test_the_console_script_target_is_main(capsys) -> None:  # type: ignore[no-untyped-def]
+    """The console script ``digslam`` is ``digslam.agents.cli.main:main``."""
+    from importlib import metadata
+
+    eps = [e for e in metadata.entry_points(group="console_scripts") if e.name == "digslam"]
+    assert eps and eps[0].value == "digslam.agents.cli.main:main"
+    with pytest.raises(SystemExit) as exc:
+        eps[0].load()(["--help"])
+    assert exc.value.code == 0 and "usage: digslam" in capsys.readouterr().out
+
+
+def test_argparse_and_the_cli_only_inside_the_cli_folder() -> None:
+    """No module of ``agents/`` outside ``agents/cli/`` imports argparse or ``digslam.agents.cli``, at module
+    level or inside a function."""
+    root = Path(cli.__file__).resolve().parents[1]
+    bad = []
+    for path in sorted(root.rglob("*.py")):
+        if "cli" in path.relative_to(root).parts[:1]:
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else []
+            if isinstance(node, ast.ImportFrom) and node.module:
+                names = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+            if any(n == "argparse" or n.startswith("digslam.agents.cli") for n in names):
+                bad.append(f"{path.relative_to(root)}:{node.lineno}")
+    assert not bad, bad
 
 
 def test_demo_at_reduced_length(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
@@ -47,7 +82,7 @@ def test_demo_at_reduced_length(tmp_path, capsys) -> None:  # type: ignore[no-un
 
 
 def test_demo_falls_back_to_frontier_without_the_shipped_model(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
-    monkeypatch.setattr(cli, "PRETRAINED", tmp_path / "missing.zip")
+    monkeypatch.setattr(models, "PRETRAINED", tmp_path / "missing.zip")
     with pytest.warns(UserWarning, match="frontier"):
         name, policy, _ = cli.resolve_agent("ppo", cli.DEFAULT_ENV, None)
     assert name == "frontier" and hasattr(policy, "predict")
@@ -84,6 +119,6 @@ def test_bad_arguments_are_reported(tmp_path, capsys) -> None:  # type: ignore[n
 def test_benchmark_runs_scripts_or_explains(monkeypatch, capsys) -> None:  # type: ignore[no-untyped-def]
     assert cli.main(["benchmark", "no_such_bench"]) == 2
     assert "known:" in capsys.readouterr().err
-    monkeypatch.setattr(cli, "benchmarks_dir", lambda: None)
+    monkeypatch.setattr(commands, "benchmarks_dir", lambda: None)
     assert cli.main(["benchmark", "agents"]) == 2
     assert "source checkout" in capsys.readouterr().err

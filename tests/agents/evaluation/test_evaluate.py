@@ -8,7 +8,8 @@ import pytest
 
 import digslam.agents
 from digslam.agents.baselines.registry import make_baseline
-from digslam.agents.evaluation.evaluate import EvalResult, coverage_figure, evaluate, record_episode_gif
+from digslam.agents.evaluation.evaluate import EvalResult, coverage_figure, evaluate
+from digslam.agents.evaluation.pictures import record_episode_gif
 
 SMALL = {"map_size": 36}
 

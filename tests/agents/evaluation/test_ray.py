@@ -17,11 +17,11 @@ import pytest
 ray = pytest.importorskip("ray")
 pytest.importorskip("ray.tune")
 
+from digslam.agents.cli.distributed import add_ray_options as add_eval_cli  # noqa: E402
+from digslam.agents.cli.distributed import add_sweep_parser as add_sweep_cli  # noqa: E402
 from digslam.agents.evaluation.evaluate import evaluate  # noqa: E402
-from digslam.agents.evaluation.ray_eval import add_cli as add_eval_cli  # noqa: E402
 from digslam.agents.evaluation.ray_eval import build_policy, evaluate_ray, merge_results, normalize_specs  # noqa: E402
 from digslam.agents.learning.sweep import SweepConfig, run_sweep  # noqa: E402
-from digslam.agents.learning.sweep import add_cli as add_sweep_cli  # noqa: E402
 
 ENV = "digslam/DigCoverage-v0"
 SMALL = {"map_size": 36}
@@ -119,14 +119,14 @@ def test_example_sweep_file_and_cli(tmp_path: Path) -> None:
 
 
 def test_evaluate_ray_handler_on_the_cli_parser(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
-    """``add_cli`` on the real ``digslam evaluate`` parser: ``--ray`` turns the parsed agents into specs
+    """``add_ray_options`` on the real ``digslam evaluate`` parser: ``--ray`` turns the parsed agents into specs
     (``ppo`` -> the ``--model`` path with its sidecar's env keywords) for ``evaluate_ray``."""
     import json
 
     import digslam.agents.evaluation.ray_eval as ray_eval
     from digslam.agents.cli.main import build_parser
 
-    parser = build_parser()  # ``digslam evaluate`` carries the ``--ray`` options of ``add_cli``
+    parser = build_parser()  # ``digslam evaluate`` carries the ``--ray`` options of ``add_ray_options``
     model = tmp_path / "m.zip"
     model.write_bytes(b"")
     model.with_suffix(".json").write_text(json.dumps({"env_kwargs": {"map_size": 40, "fixed_world": True}}))

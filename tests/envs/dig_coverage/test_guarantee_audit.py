@@ -115,11 +115,11 @@ def test_certified_never_exceeds_ground_truth_caves_frontier() -> None:
     two divided by different areas. Both are now shares of the reachable free area; the monitor checks
     certified <= ground truth (and that every clear reachable cell's centre was truly sensed) at each step."""
     from digslam.agents.cli.main import resolve_agent
-    from digslam.agents.evaluation.evaluate import _make_env
+    from digslam.agents.evaluation.evaluate import make_env
 
     env_id = "digslam/DigCoverageCaves-v0"
     _, agent, kwargs = resolve_agent("frontier", env_id, None)
-    env = _make_env(env_id, 300, {**kwargs, "monitor": True})
+    env = make_env(env_id, 300, {**kwargs, "monitor": True})
     obs, info = env.reset(seed=0)
     inner = _observer(env)
     assert inner.monitor is not None and inner.monitor.coverage is not None

@@ -104,7 +104,7 @@ def test_robot_pose_error_bounds_the_exact_chain(seed: int) -> None:
     episode: the accumulated bound covers the distance between the simulator's pose and the exact chain."""
     rng = np.random.default_rng(seed)
     world = _room()
-    sim = RobotSim(world, 0.2, np.array([-3.0, 0.5, 0.3]))
+    sim = RobotSim(world, 0.2, np.array([-3.0, 0.5, 0.3]), dynamics="unicycle")
     ex, ey = mp.mpf(-3.0), mp.mpf(0.5)
     th_prev = sim.pose[2]
     t = 0.0

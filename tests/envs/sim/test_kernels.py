@@ -185,7 +185,7 @@ def test_robot_step_matches_numpy_oracle(seed: int) -> None:
     sliver = np.array([(1.0, -3.0), (1.001, -3.0), (1.001, 3.0), (1.0, 3.0)])  # a 1 mm wall
     world = World((-5, -5, 5, 5), [frame, sliver] + RockField(n=6, size=5.0).generate(seed).rings[1:])
     radius, blocked = 0.2, 0
-    sim = RobotSim(world, radius, world.sample_free_pose(rng, 0.5))
+    sim = RobotSim(world, radius, world.sample_free_pose(rng, 0.5), dynamics="unicycle")
     for k in range(1000):
         v = float(rng.choice([2.0, -2.0, 1.0, 0.0])) * rng.uniform(0.5, 1.0)
         w = float(rng.choice([0.0, 1e-13, rng.uniform(-2, 2)]))
@@ -273,10 +273,11 @@ def test_kernel_module_doctests(name: str) -> None:
     assert res.attempted > 0 and res.failed == 0
 
 
-def test_observation_matches_numpy_oracle() -> None:
+@pytest.mark.parametrize("dynamics", ["pymunk", "unicycle"])
+def test_observation_matches_numpy_oracle(dynamics: str) -> None:
     from digslam.envs import ExploreEnv
 
-    env = ExploreEnv(world="rocks", noise={"range": 0.05})
+    env = ExploreEnv(world="rocks", noise={"range": 0.05}, dynamics=dynamics)
     env.reset(seed=3)
     rng = np.random.default_rng(5)
     top, odo_top, hb = env._top, env._odo_top, env.observation_space["heading"]
@@ -286,13 +287,16 @@ def test_observation_matches_numpy_oracle() -> None:
         if k % 3 == 0:  # headings far from [-pi, pi], odometry beyond the clip
             rec.heading[:] += 2 * np.pi * rng.integers(-5, 6) + [0.0, 1e-3]
             rec.speed[:] *= rng.choice([1.0, 1e3])
+            rec.lateral[:] = rec.lateral * rng.choice([1.0, 1e3]) + np.array([-1.0, 1.0]) * rng.choice([0.0, 50.0])
             obs = env._obs(rec)
         h = rec.heading
         kk = np.round(0.5 * (h[0] + h[1]) / (2 * math.pi)) * 2 * math.pi
         ref = {
             "ranges": np.minimum(rec.range, top),
             "no_echo": rec.no_echo.astype(np.int8),
-            "odometry": np.minimum(np.maximum(np.array([rec.speed, rec.yaw_rate]), -odo_top), odo_top),
+            "odometry": np.minimum(
+                np.maximum(np.array([rec.speed, rec.lateral, rec.yaw_rate]), -odo_top), odo_top
+            ),
             "heading": np.minimum(np.maximum(h - kk, hb.low), hb.high),
         }
         for key, val in ref.items():
@@ -300,10 +304,11 @@ def test_observation_matches_numpy_oracle() -> None:
         assert env.observation_space.contains(obs)
 
 
-def test_ground_truth_of_step_is_the_plain_constructor() -> None:
+@pytest.mark.parametrize("dynamics", ["unicycle", "pymunk"])
+def test_ground_truth_of_step_is_the_plain_constructor(dynamics: str) -> None:
     from digslam.envs.explore.episode import GroundTruth
 
-    args = (
+    args: tuple = (
         1.5,
         np.array([0.1, -0.2, 7.0]),
         0.25,
@@ -314,6 +319,9 @@ def test_ground_truth_of_step_is_the_plain_constructor() -> None:
         np.array([[0.25, 0.05, 6.9], [0.0, 0.05, 7.0]]),
         1e-15,
     )
+    if dynamics == "pymunk":  # the lateral velocity and the substep path
+        args = (*args[:7], np.full((2, 3), np.nan), 0.0, 0.125, np.array([[0.0, 0.0, 6.9], [0.1, -0.2, 7.0]]),
+                np.array([0.1]))  # fmt: skip
     fast, plain = GroundTruth.of_step(*args), GroundTruth(*args)
     assert fast == plain
     for a, b in zip(fast.as_dict().values(), plain.as_dict().values(), strict=True):

@@ -131,33 +131,40 @@ def _facing_nearest_wall(env: ExploreEnv, seed: int) -> tuple[float, float, floa
     return float(x), float(y), math.atan2(p[k, 1] - y, p[k, 0] - x)
 
 
+@pytest.mark.parametrize("dynamics", ["unicycle", "pymunk"])
 @pytest.mark.parametrize("world,noise", [("room", "zero"), ("rocks", "adversarial"), ("rooms", "uniform")])
-def test_premise_holds_against_a_wall(world: str, noise: str) -> None:
-    """Drive full speed into the nearest wall for many steps (blocked pieces, reduced speeds), then keep
-    pressing with tiny and sign-alternating yaw actions."""
-    probe = ExploreEnv(world=world, n_obstacles=12)
+def test_premise_holds_against_a_wall(world: str, noise: str, dynamics: str) -> None:
+    """Drive full speed into the nearest wall for many steps (unicycle: blocked pieces, reduced speeds;
+    pymunk: contacts, the disc kept off the wall), then keep pressing with tiny and sign-alternating yaw
+    actions."""
+    probe = ExploreEnv(world=world, n_obstacles=12, dynamics=dynamics)
     start = _facing_nearest_wall(probe, 960300)
-    env = ExploreEnv(world=world, n_obstacles=12, noise=NOISES[noise], start=start)
+    env = ExploreEnv(world=world, n_obstacles=12, noise=NOISES[noise], start=start, dynamics=dynamics)
     acts = [(1.0, 0.0)] * 70 + [(1.0, 2e-12), (1.0, -2e-12), (1.0, 5e-324), (1.0, 1e-9), (-1.0, 1e-12)] * 3
-    chk = check_episode(env, 960300, acts, dense=False)
+    chk = check_episode(env, 960300, acts, dense=False, radius=env.config.robot_radius)
     assert chk.k == len(acts)
     assert env.sim.bumps >= 1  # it did hit the wall
+    if dynamics == "pymunk":
+        assert chk.substeps == 4 * len(acts) and len(chk.paths) == len(acts)
+        assert env.sim.stops <= 2  # the skin keeps pymunk's contacts off the disc
+        return
     seg = np.array(chk.pieces)
     blocked = (seg[:, 1, 1] > 0) & (seg[:, 1, 0] != seg[:, 0, 0])
     assert blocked.sum() >= 10  # many steps ran a reduced-speed (or stopped) second piece
 
 
 # --- the checker catches corrupted records -----------------------------------------------------------------
-def _one_step(noise: str = "zero") -> tuple[ExploreEnv, dict, dict]:
-    env = ExploreEnv(world="rocks", n_obstacles=12, noise=NOISES[noise])
+def _one_step(noise: str = "zero", dynamics: str = "pymunk") -> tuple[ExploreEnv, dict, dict]:
+    env = ExploreEnv(world="rocks", n_obstacles=12, noise=NOISES[noise], dynamics=dynamics)
     _, info0 = env.reset(seed=960400)
     _, _, _, _, info1 = env.step(np.array([1.0, 0.3]))
     return env, info0, info1
 
 
-@pytest.mark.parametrize("what", ["range", "no_echo", "heading", "speed", "yaw", "pose", "tau"])
-def test_the_checker_catches_a_corrupted_record(what: str) -> None:
-    env, info0, info1 = _one_step()
+@pytest.mark.parametrize("dynamics", ["unicycle", "pymunk"])
+@pytest.mark.parametrize("what", ["range", "no_echo", "heading", "speed", "yaw", "lateral", "pose", "tau"])
+def test_the_checker_catches_a_corrupted_record(what: str, dynamics: str) -> None:
+    env, info0, info1 = _one_step(dynamics=dynamics)
     rec, truth = copy.deepcopy(info1["record"]), copy.deepcopy(info1["truth"])
     echo = np.nonzero(~rec.no_echo)[0]
     if what == "range":
@@ -171,8 +178,12 @@ def test_the_checker_catches_a_corrupted_record(what: str) -> None:
         rec.speed[:] = (rec.speed[1] + 1e-12, rec.speed[1] + 1.0)
     elif what == "yaw":
         rec.yaw_rate[:] = (rec.yaw_rate[1] + 1e-12, rec.yaw_rate[1] + 1.0)
+    elif what == "lateral":  # pymunk: a 1 m/s turn makes the lateral hull about +-0.0125 m/s wide
+        rec.lateral[:] = (rec.lateral[1] + 1e-12, rec.lateral[1] + 1.0)
     elif what == "pose":
         truth.pose[0] += 1e-9
+    elif dynamics == "pymunk":
+        truth.taus[0] += 1e-3
     else:
         truth.pieces[0, 1] += 1e-3
     chk = PremiseChecker(env.world.edges)

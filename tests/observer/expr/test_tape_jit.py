@@ -11,10 +11,10 @@ import pytest
 
 from digslam.observer import Box, Function, Interval, SepInverse, pave
 from digslam.observer.core.boxes import normalize_empty
-from digslam.observer.core.scalar_jit import njit
+from digslam.observer.core.scalar_jit import dn, njit, up
 from digslam.observer.expr.hc4_jit import hc4, image, sep_box
 from digslam.observer.expr.ops import exp, log, sin, sqrt
-from digslam.observer.expr.tape_jit import Tape, dn, up
+from digslam.observer.expr.tape_jit import Tape
 from digslam.observer.sets.contractors import CtcFwdBwd, hc4_backward
 from digslam.observer.sets.separators import SepBox, SepInter, SepNot, SepUnion, hull_batch, inter_batch
 from digslam.observer.sets.testing import assert_separator_sound, random_boxes

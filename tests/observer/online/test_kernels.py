@@ -11,10 +11,13 @@ shared ground-truth checks of a whole mission.
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 
 import numpy as np
 import pytest
 from ground_truth import assert_free
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from digslam.envs.config import NoiseConfig
 from digslam.envs.dig_coverage.maps_jit import fill_map, observer_sets, three_state
@@ -22,14 +25,16 @@ from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.missions import loop_mission
 from digslam.envs.sim.sensors import SensorSuite
 from digslam.observer.core import rounding as rnd
+from digslam.observer.online.dig_jit import PoseBox, StepRecord
 from digslam.observer.online.observer import OnlineDigSlam
-from digslam.observer.online.pose_jit import cos_sin, predict
+from digslam.observer.online.pose_jit import TRIG_PAD, cos_sin, predict, rotate
 from digslam.observer.online.window import MARGIN, WindowDigMap, mark_possibly_sensed
 from digslam.observer.slam.digmap import EDT_SLACK, DigMap
 from digslam.observer.slam.grid import Grid
 from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
 
 G = Grid((-6.0, -6.0), (6.0, 6.0), (96, 96))
+PI_40 = Fraction("3.1415926535897932384626433832795028841971")  # π to 40 digits
 
 
 # ------------------------------------------------------------------ numpy oracles (the previous kernels)
@@ -232,6 +237,98 @@ def _old_predict(lo, hi, h0l, h0h, dt, yl, yh, cl_, ch_, vl, vh):  # noqa: ANN00
     return hl, hh, dn(lo[0] + d[0][0]), dn(lo[1] + d[1][0]), up(hi[0] + d[0][1]), up(hi[1] + d[1][1])
 
 
+def _step(dt: float, yaw: tuple, comp: tuple, speed: tuple, n: int = 0, lateral: tuple = (0.0, 0.0)
+          ) -> StepRecord:  # fmt: skip
+    """A :class:`StepRecord` with these odometry intervals (a unicycle by default) and ``n`` dummy readings."""
+    z = np.zeros(n)
+    return StepRecord(dt, np.array(speed, float), np.array(lateral, float), np.array(yaw, float),
+                      np.array(comp, float), z, z, z, np.zeros((n, 2)), np.zeros(n, bool))  # fmt: skip
+
+
+def _old_cos_sin(a: float, b: float) -> tuple[float, float, float, float]:
+    """The former loop of :func:`cos_sin` (before :func:`~digslam.observer.core.angles_jit.axes_in`)."""
+    if not (math.isfinite(a) and math.isfinite(b)):
+        return -1.0, 1.0, -1.0, 1.0
+    f0, f1 = math.floor(a / rnd.HALF_PI_UP) - 1.0, math.floor(b / rnd.HALF_PI_DOWN) + 1.0
+    if f1 - f0 > 8.0:
+        return -1.0, 1.0, -1.0, 1.0
+    ca, cb, sa, sb = math.cos(a), math.cos(b), math.sin(a), math.sin(b)
+    c0, c1 = min(ca, cb) - TRIG_PAD, max(ca, cb) + TRIG_PAD
+    s0, s1 = min(sa, sb) - TRIG_PAD, max(sa, sb) + TRIG_PAD
+    for m in range(int(f0), int(f1) + 1):
+        p = m * rnd.HALF_PI_DOWN
+        eps = abs(p) * 1e-15 + 1e-300
+        if a - eps <= p <= b + eps:
+            c1, s1, c0, s0 = (1.0, s1, c0, s0) if m % 4 == 0 else (c1, 1.0, c0, s0) if m % 4 == 1 else (
+                (c1, s1, -1.0, s0) if m % 4 == 2 else (c1, s1, c0, -1.0))  # fmt: skip
+    return max(c0, -1.0), min(c1, 1.0), max(s0, -1.0), min(s1, 1.0)
+
+
+def test_cos_sin_is_the_former_loop_and_axes_in_never_misses_an_axis() -> None:
+    from digslam.observer.core.angles_jit import axes_in
+
+    rng = np.random.default_rng(12)
+    q = np.arange(-40, 41) * (math.pi / 2)
+    ends = np.concatenate([rng.uniform(-30, 30, 400), q, np.nextafter(q, np.inf), np.nextafter(q, -np.inf)])
+    for a in ends:
+        for w in (0.0, 1e-12, 0.3, 1.6, 3.2, 6.3, 20.0):
+            b = a + w
+            assert cos_sin(a, b) == _old_cos_sin(a, b)
+            got = axes_in(a, b)
+            # exact reals m·π/2 in [a, b] (Fraction arithmetic on π to 40 digits is plenty here)
+            for m in range(math.floor(a / (math.pi / 2)) - 2, math.floor(b / (math.pi / 2)) + 3):
+                p = m * (PI_40 / 2)
+                if Fraction(a) <= p <= Fraction(b):
+                    assert got[m % 4], (a, b, m)
+    assert axes_in(np.nan, 1.0) == (True,) * 4 and axes_in(0.0, np.inf) == (True,) * 4
+
+
+def test_grid_frame_gives_the_grid_s_cell_size_and_frame_exactly() -> None:
+    from digslam.observer.online.dig_jit import cell_size, in_frame
+    from digslam.observer.online.window import grid_frame
+
+    rng = np.random.default_rng(14)
+    for _ in range(200):
+        lo = rng.uniform(-50, 50, 2)
+        hi = lo + rng.uniform(1e-3, 80, 2)
+        g = Grid(lo, hi, tuple(int(v) for v in rng.integers(1, 300, 2)))
+        f = grid_frame(g)
+        assert cell_size(f) == g.cell_size
+        (x0, y0), (x1, y1) = g.lo, g.hi
+        assert in_frame(f, x0, y0, x1, y1) and not in_frame(f, np.nextafter(x0, -np.inf), y0, x1, y1)
+        assert not in_frame(f, x0, y0, x1, np.nextafter(y1, np.inf)) and not in_frame(f, x1, y0, x0, y1)
+
+
+def test_window_is_the_former_bisection() -> None:
+    from digslam.observer.core.grid_jit import window
+
+    def count(a, v, strict):  # noqa: ANN001, ANN202
+        lo, hi = 0, a.size
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if a[mid] < v or (not strict and a[mid] == v):
+                lo = mid + 1
+            else:
+                hi = mid
+        return lo
+
+    def old(xs, nys, x0, y0, x1, y1):  # noqa: ANN001, ANN202
+        nx, ny = xs.size - 1, nys.size - 1
+        c0 = min(max(count(xs, x0, True) - 1, 0), nx)
+        c1 = min(max(count(xs, x1, False), c0), nx)
+        r0 = min(max(count(nys, -y1, True) - 1, 0), ny)
+        r1 = min(max(count(nys, -y0, False), r0), ny)
+        return r0, r1, c0, c1
+
+    g = Grid((-2.0, -1.0), (2.0, 3.0), (8, 5))
+    xs, nys = np.array(g.xs), np.array(-g.ys)
+    vals = np.concatenate([xs, -nys, [-9.0, 9.0, np.inf, -np.inf, np.nan, 0.1, -0.3, 2.2]])
+    rng = np.random.default_rng(13)
+    for _ in range(3000):
+        x0, y0, x1, y1 = rng.choice(vals, 4)
+        assert window(xs, nys, x0, y0, x1, y1) == old(xs, nys, x0, y0, x1, y1)
+
+
 def test_predict_equals_the_scalar_python_step_and_encloses_the_motion() -> None:
     rng = np.random.default_rng(4)
     for _ in range(200):
@@ -242,7 +339,11 @@ def test_predict_equals_the_scalar_python_step_and_encloses_the_motion() -> None
         yl = rng.uniform(-1, 1)
         vl = rng.uniform(-0.2, 1.0)
         args = (h0l, h0h, dt, yl, yl + 0.05, -np.inf, np.inf, vl, vl + 0.05)
-        ok, hl, hh, x0, y0, x1, y1, *_ = predict(lo[0], lo[1], hi[0], hi[1], *args)
+        ok, box, _ = predict(
+            PoseBox(lo[0], lo[1], hi[0], hi[1], h0l, h0h),
+            _step(dt, (yl, yl + 0.05), (-np.inf, np.inf), (vl, vl + 0.05)),
+        )
+        x0, y0, x1, y1, hl, hh = box
         assert ok and (hl, hh, x0, y0, x1, y1) == _old_predict(lo, hi, *args)
         # a constant-rate motion from a pose of the box stays in the predicted box
         t = np.linspace(0, dt, 9)
@@ -338,6 +439,7 @@ def test_wrapper_sets_kept_up_to_date_equal_the_filter_sets(window: int) -> None
 
 
 def test_dig_and_mark_window_holds_every_changed_cell_and_filter_step_matches_the_kernels() -> None:
+    from digslam.observer.online.dig_jit import CellSets
     from digslam.observer.online.mark_jit import dig_and_mark
     from digslam.observer.online.pose_jit import contract, impact_bound
     from digslam.observer.online.step_jit import filter_step
@@ -356,25 +458,26 @@ def test_dig_and_mark_window_holds_every_changed_cell_and_filter_step_matches_th
         rg[no_echo] = [3.0, np.inf]
         yaw, comp, speed = np.array([-0.3, 0.3]), np.array([h[0] - 0.1, h[1] + 0.1]), np.array([0.4, 0.6])
         f0, s0, m0 = free.copy(), sure.copy(), maybe.copy()
+        step = StepRecord(0.1, speed, np.zeros(2), yaw, comp, alpha, gamma, r_max, rg, no_echo)
         # the fused step equals predict + Eq. 6.22 + dig_and_mark called one by one
-        ok, hl, hh, x0, y0, x1, y1, *disp = predict(lo[0], lo[1], hi[0], hi[1], h[0], h[1], 0.1, *yaw, *comp,
-                                                    *speed)  # fmt: skip
+        ok, box, disp = predict(PoseBox(lo[0], lo[1], hi[0], hi[1], h[0], h[1]), step)
         assert ok
+        x0, y0, x1, y1, hl, hh = box
         rb = impact_bound(no_echo, rg)
         if math.isfinite(rb):
-            x0, y0, x1, y1 = contract(f0, d.xs, d.ys, d.nys, x0, y0, x1, y1, rb, *g.cell_size, d.keep, d.off)
-        st = np.empty(10)
-        code, *win = filter_step(free, sure, maybe, d.xs, d.ys, d.nys, d.frame, lo, hi, h[0], h[1], st, 0.1,
-                                 yaw, comp, speed, alpha, gamma, r_max, rg, no_echo, True)  # fmt: skip
+            x0, y0, x1, y1 = contract(f0, d.frame, x0, y0, x1, y1, rb)
+        new = (lo.copy(), hi.copy(), np.array(h))
+        cells = CellSets(free, sure, maybe, np.zeros((2, 1, 1), np.int32), np.zeros(1, np.int32))
+        code, *win, shift = filter_step(cells, d.frame, step, *new, True)
         if not x0 <= x1 or not y0 <= y1:  # the random ranges contradict the dug cells: start again
             assert code == 1
             lo, hi, h = np.array([-0.1, -0.2]), np.array([0.1, 0.0]), (-0.05, 0.05)
             free[:], sure[:], maybe[:] = False, False, False
             continue
-        assert code == 0 and st.tolist() == [x0, y0, x1, y1, hl, hh, *disp]
+        assert code == 0 and [*np.concatenate(new).tolist(), *shift] == [x0, y0, x1, y1, hl, hh, *disp]
         f1, s1, m1 = f0.copy(), s0.copy(), m0.copy()
-        assert dig_and_mark(f1, s1, m1, d.xs, d.ys, d.nys, x0, y0, x1, y1, hl, hh, alpha, gamma, r_max, rg,
-                            True) == tuple(win)  # fmt: skip
+        c1 = CellSets(f1, s1, m1, np.zeros((2, 1, 1), np.int32), np.zeros(1, np.int32))
+        assert dig_and_mark(c1, d.frame, PoseBox(x0, y0, x1, y1, hl, hh), step, True) == tuple(win)
         assert np.array_equal(f1, free) and np.array_equal(s1, sure) and np.array_equal(m1, maybe)
         changed = (free != f0) | (sure != s0) | (maybe != m0)
         r0, r1, c0, c1 = win
@@ -384,13 +487,20 @@ def test_dig_and_mark_window_holds_every_changed_cell_and_filter_step_matches_th
         if changed.any():  # the smallest such window
             rows, cols = np.nonzero(changed)
             assert (r0, r1, c0, c1) == (rows.min(), rows.max() + 1, cols.min(), cols.max() + 1)
-        lo, hi, h = st[0:2].copy(), st[2:4].copy(), (st[4], st[5])
+        lo, hi, h = new[0].copy(), new[1].copy(), (new[2][0], new[2][1])
         lo, hi = np.clip(lo, -3.0, 3.0), np.clip(np.maximum(hi, lo), -3.0, 3.0)
 
 
 def test_observe_matches_its_pieces() -> None:
-    from digslam.envs.dig_coverage.maps_jit import observe, pixel_blocks, pixel_range, sets_and_map
-    from digslam.observer.online.dig_jit import window
+    from digslam.envs.dig_coverage.maps_jit import (
+        MapPlanes,
+        map_context,
+        observe,
+        pixel_blocks,
+        pixel_range,
+        sets_and_map,
+    )
+    from digslam.observer.core.grid_jit import window
 
     rng = np.random.default_rng(6)
     for n, m in ((40, 36), (30, 64), (64, 64)):
@@ -403,12 +513,13 @@ def test_observe_matches_its_pieces() -> None:
         base, ref_base = np.zeros((3, m, m), np.uint8), np.zeros((3, m, m), np.uint8)
         lo, hi = np.sort(rng.uniform(-2.0, 2.0, (2, 2)), axis=0)
         img, state = np.empty((4, m, m), np.uint8), np.empty(11, np.float32)
-        norm = np.array([0.0, 0.0, 2.0, 2.0, 100.0])
         win = (3, n - 5, 2, n // 2)
         ref = sets_and_map(sure, maybe, free, reach, explored, clear, dark, ref_base, win)
         snap = np.empty((3, n, n), np.uint8)
-        got = observe(sure, maybe, free, planes, base, img, win, g.xs, -g.ys, lo, hi, (0.1, 0.3), norm, 7,
-                      int(reach.sum()), 5, state, snap)  # fmt: skip
+        maps = map_context(
+            (sure, maybe, free), MapPlanes(*planes), base, g.xs, -g.ys, 100.0, int(reach.sum())
+        )
+        got = observe(maps, lo, hi, (0.1, 0.3), win, 7, 5, img, state, snap)
         assert np.array_equal(snap[:2], planes[:2]) and np.array_equal(snap[2], free)
         assert got == ref + 5 and np.array_equal(base, ref_base) and np.array_equal(img[:3], ref_base)
         assert np.array_equal(planes[0].view(np.int8)[3 : n - 5, 2 : n // 2], explored[3 : n - 5, 2 : n // 2])
@@ -417,7 +528,88 @@ def test_observe_matches_its_pieces() -> None:
         q0, q1 = pixel_range(c0, c1, n, m)
         foot = np.zeros((m, m), np.uint8)
         foot[p0:p1, q0:q1] = 255
-        assert np.array_equal(img[3], foot) and pixel_blocks((n, n), m).shape == (4, m)
+        assert np.array_equal(img[3], foot) and np.array(pixel_blocks((n, n), m)).shape == (4, m)
         want = [lo[0] / 2, lo[1] / 2, hi[0] / 2, hi[1] / 2, math.cos(0.2), math.sin(0.2), 0.1 / math.pi,
                 math.tanh(max(hi - lo)), 0.07, (ref + 5) / reach.sum(), 1.0]  # fmt: skip
         assert np.array_equal(state, np.array(want, np.float32))
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    v1=st.tuples(st.floats(-3, 5), st.floats(0, 3)),
+    v2=st.tuples(st.floats(-2, 2), st.floats(0, 2)),
+    psi=st.tuples(st.floats(-20, 20), st.floats(0, 7)),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_rotate_contains_the_rotated_velocities(v1: tuple, v2: tuple, psi: tuple, seed: int) -> None:
+    """The compiled enclosure of ``R([psi]) [v]`` (Eq. 3.59, 6.12, B.20) holds ``R(psi) v`` for sampled
+    ``psi``, ``v = (v_1, v_2)`` (the corners included; mpmath at 40 digits)."""
+    import mpmath
+
+    v1l, v1h, v2l, v2h = v1[0], v1[0] + v1[1], v2[0], v2[0] + v2[1]
+    pl, ph = psi[0], psi[0] + psi[1]
+    u0l, u0h, u1l, u1h = rotate(v1l, v1h, v2l, v2h, *cos_sin(pl, ph))
+    rng = np.random.default_rng(seed)
+    pts = [(a, b, p) for a in (v1l, v1h) for b in (v2l, v2h) for p in (pl, ph)]
+    pts += list(zip(rng.uniform(v1l, v1h, 16), rng.uniform(v2l, v2h, 16), rng.uniform(pl, ph, 16)))
+    with mpmath.workdps(40):
+        for a, b, p in pts:
+            if not (v1l <= a <= v1h and v2l <= b <= v2h and pl <= p <= ph):
+                continue
+            c, s = mpmath.cos(mpmath.mpf(p)), mpmath.sin(mpmath.mpf(p))
+            a_, b_ = mpmath.mpf(a), mpmath.mpf(b)
+            assert mpmath.mpf(u0l) <= a_ * c - b_ * s <= mpmath.mpf(u0h), (a, b, p)
+            assert mpmath.mpf(u1l) <= a_ * s + b_ * c <= mpmath.mpf(u1h), (a, b, p)
+
+
+def test_rotate_without_lateral_is_the_unicycle_product() -> None:
+    """``[v_2] = [0, 0]``: :func:`rotate` is the unicycle's ``[v_1]·[c]``, ``[v_1]·[s]`` to the bit (what
+    keeps every unicycle step of the filter unchanged); with ``v_2`` it encloses them, signs of zero
+    included, and an unbounded ``v_2`` gives unbounded bounds, never NaN."""
+    from digslam.observer.online.dig_jit import prod_hi, prod_lo
+
+    rng = np.random.default_rng(21)
+    for _ in range(500):
+        vl = float(rng.choice([0.0, -0.5, rng.uniform(-2, 2)]))
+        vh = vl + float(rng.choice([0.0, rng.uniform(0, 1)]))
+        pl = rng.uniform(-7, 7)
+        cs = cos_sin(pl, pl + rng.uniform(0, 2))
+        uni = (prod_lo(vl, vh, cs[0], cs[1]), prod_hi(vl, vh, cs[0], cs[1]), prod_lo(vl, vh, cs[2], cs[3]),
+               prod_hi(vl, vh, cs[2], cs[3]))  # fmt: skip
+        got = rotate(vl, vh, 0.0, 0.0, *cs)
+        assert np.array(got).tobytes() == np.array(uni).tobytes()
+        w = rotate(vl, vh, -0.1, 0.2, *cs)
+        assert w[0] <= got[0] and got[1] <= w[1] and w[2] <= got[2] and got[3] <= w[3]
+    inf = rotate(1.0, 1.0, -np.inf, np.inf, 0.5, 0.6, -0.1, 0.1)
+    assert inf == (-np.inf, np.inf, -np.inf, np.inf)
+
+
+def test_predict_with_lateral_slip_encloses_the_motion() -> None:
+    """A constant-rate motion with sideways slip from a pose of the prior box, ``x' = R(psi) v`` (Eq. 3.59,
+    6.12, B.20; exact closed form in mpmath), ends in the predicted box."""
+    import mpmath
+
+    rng = np.random.default_rng(22)
+    for _ in range(200):
+        lo = rng.uniform(-5, 5, 2)
+        hi = lo + rng.uniform(0, 0.3, 2)
+        h0l = rng.uniform(-7, 7)
+        h0h, dt = h0l + rng.uniform(0, 0.2), rng.uniform(0.01, 0.3)
+        yl, vl, ll = rng.uniform(-1, 1), rng.uniform(-0.2, 1.0), rng.uniform(-0.5, 0.5)
+        step = _step(dt, (yl, yl + 0.05), (-np.inf, np.inf), (vl, vl + 0.05), lateral=(ll, ll + 0.05))
+        ok, box, d = predict(PoseBox(lo[0], lo[1], hi[0], hi[1], h0l, h0h), step)
+        assert ok
+        x0, y0, x1, y1, hl, hh = box
+        with mpmath.workdps(40):
+            for _k in range(5):
+                w, v, u = (mpmath.mpf(rng.uniform(a, a + 0.05)) for a in (yl, vl, ll))
+                h = mpmath.mpf(rng.uniform(h0l, h0h))
+                if w == 0:
+                    continue
+                x = [mpmath.mpf(a) for a in lo + (hi - lo) * rng.random(2)]
+                e = h + w * mpmath.mpf(dt)
+                ds, dc = mpmath.sin(e) - mpmath.sin(h), mpmath.cos(e) - mpmath.cos(h)
+                end = (x[0] + (v * ds + u * dc) / w, x[1] + (u * ds - v * dc) / w)
+                assert mpmath.mpf(x0) <= end[0] <= mpmath.mpf(x1), (lo, hi, dt)
+                assert mpmath.mpf(y0) <= end[1] <= mpmath.mpf(y1), (lo, hi, dt)
+                assert mpmath.mpf(hl) <= e <= mpmath.mpf(hh)

@@ -12,7 +12,8 @@ from digslam.envs.config import NoiseConfig
 from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.missions import loop_mission
 from digslam.envs.sim.sensors import SensorSuite
-from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam, _cos_sin
+from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam
+from digslam.observer.online.pose_jit import cos_sin
 from digslam.observer.online.window import WindowDigMap, mark_possibly_sensed
 from digslam.observer.slam.digmap import DigMap
 from digslam.observer.slam.digslam import dig_slam
@@ -202,7 +203,7 @@ def test_cos_sin_enclosures():
     a = np.concatenate([rng.uniform(-20, 20, 300), np.arange(-12, 13) * math.pi / 2])
     for lo, w in zip(a, rng.choice([0.0, 1e-3, 0.3, 2.0], a.size), strict=True):
         hi = lo + w
-        cl, ch, sl, sh = _cos_sin(lo, hi)
+        cl, ch, sl, sh = cos_sin(lo, hi)
         x = np.linspace(lo, hi, 101)
         assert (
             cl <= np.cos(x).min()
@@ -239,3 +240,22 @@ def test_bad_input():
         f.update(rec[0])  # time does not increase
     f.update(rec[1])
     assert f.consistent and f.steps == 2 and f.last_update_seconds > 0
+
+
+@pytest.mark.parametrize("window", [0, 4])
+def test_lateral_slip_stays_in_the_pose_box(window):
+    """``x' = R(psi) v`` with ``v_2 != 0`` (Eq. 3.59, 6.12, B.20): a robot sliding sideways at 0.3 m/s while
+    it turns stays in the pose box at every step (exact truth, :mod:`slip_mission`), and the online boxes
+    hold the offline gates; the unicycle model (``lateral`` forced to ``[0, 0]``) loses it."""
+    from slip_mission import N, inside, mission, truth
+
+    rec = mission()
+    f, lo, hi = run(rec, np.zeros(2), OnlineConfig(smoothing_window=window))
+    assert all(inside(lo[k], hi[k], float(rec.t[k])) for k in range(N))
+    assert f.heading_lo <= truth(float(rec.t[-1]))[2] <= f.heading_hi
+    assert float(np.max(hi - lo)) < 0.5  # the guarantee is not vacuous
+    off = dig_slam(rec, GRID, [0.0, 0.0], [0.0, 0.0])
+    assert off.consistent and np.all(lo <= off.tube.gate_lo + 1e-9) and np.all(off.tube.gate_hi <= hi + 1e-9)
+    _, lo0, hi0 = run(mission(lateral=False), np.zeros(2), OnlineConfig(smoothing_window=window))
+    out = [k for k in range(N) if not inside(lo0[k], hi0[k], float(rec.t[k]))]
+    assert out and out[-1] == N - 1

@@ -1,6 +1,7 @@
 """The compiled polar contractor and pie separator (observer/core/polar_jit.py) against the numpy oracle.
 
-The numpy construction (:func:`contract_polar`, :meth:`SepPiInv.separate_numpy`) is the reference:
+The numpy construction of ``tests/polar_oracle.py`` (:func:`contract_polar`, :func:`sep_pie_numpy`) is the
+reference:
 the compiled boxes must keep every sampled solution, never be empty where it is not, and agree with
 it up to outward rounding (the compiled kernels step round-to-nearest results out by an ulp where the
 numpy kernels round exactly: after cancellation in ``ρ² - a²`` this is ~1e-14 absolute).
@@ -11,9 +12,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from polar_boxes import random_boxes
+from polar_oracle import CtcPolarNumpy, contract_polar, sep_landmark_numpy, sep_pie_numpy
 
 from digslam.observer.core.polar_jit import ctc_polar_batch
-from digslam.observer.polar.ctc import CtcPolar, CtcPolarNumpy, contract_polar
+from digslam.observer.polar.ctc import CtcPolar
 from digslam.observer.polar.sep import SepLandmark, SepPiInv
 from digslam.observer.sets.separators import check_separation
 
@@ -92,7 +94,7 @@ def test_compiled_pie_separator_equals_numpy(rho: tuple[float, float], theta: tu
     )
     s = SepPiInv(rho, theta)
     (ilo, ihi), (olo, ohi) = s.separate(lo, hi)
-    (nilo, nihi), (nolo, nohi) = s.separate_numpy(lo, hi)
+    (nilo, nihi), (nolo, nohi) = sep_pie_numpy(s, lo, hi)
     _agree((nilo, nihi), (ilo, ihi))
     _agree((nolo, nohi), (olo, ohi))
     assert not check_separation((ilo, ihi), (olo, ohi), lo, hi).any()
@@ -110,7 +112,7 @@ def test_compiled_landmark_separator_equals_numpy() -> None:
     c, w = rng.uniform(-6, 4, (3000, 2)), rng.uniform(0, 1, (3000, 2))
     lo, hi = c - w, c + w
     s = SepLandmark((0.5, -1.0), (4.0, 6.0), (-np.pi / 12, np.pi / 4))
-    a, b = s.separate(lo, hi), s.separate_numpy(lo, hi)
+    a, b = s.separate(lo, hi), sep_landmark_numpy(s, lo, hi)
     _agree(b[0], a[0])
     _agree(b[1], a[1])
     st = s.separate_stacked(lo, hi)

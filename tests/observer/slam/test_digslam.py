@@ -155,3 +155,38 @@ def test_bad_input():
     d["range"] = d["range"][:, :, ::-1].copy()
     with pytest.raises(ValueError, match="range"):
         MissionRecord(**d)
+
+
+def test_lateral_slip_stays_in_the_tube():
+    """``x' = R(psi) v`` with ``v_2 != 0`` (Eq. 3.59, 6.12, B.20): a robot sliding sideways at 0.3 m/s while
+    it turns stays in the tube at every gate and inside every slice (exact truth, :mod:`slip_mission`); the
+    unicycle model (``lateral`` forced to ``[0, 0]``) loses it, so the lateral term matters."""
+    from slip_mission import DT, N, inside, mission
+
+    grid = Grid((-8.0, -8.0), (8.0, 8.0), (64, 64))
+    res = dig_slam(mission(), grid, [0.0, 0.0], [0.0, 0.0])
+    assert res.consistent
+    tube = res.tube
+    assert all(inside(tube.gate_lo[k], tube.gate_hi[k], float(tube.t[k])) for k in range(N))
+    for k in range(N - 1):  # times strictly inside slice k
+        for f in (0.25, 0.5, 0.75):
+            assert inside(tube.slice_lo[k], tube.slice_hi[k], float(tube.t[k]) + f * DT), (k, f)
+    assert float(np.max(tube.widths())) < 0.5  # the guarantee is not vacuous
+    uni = dig_slam(mission(lateral=False), grid, [0.0, 0.0], [0.0, 0.0])
+    out = [k for k in range(N) if not inside(uni.tube.gate_lo[k], uni.tube.gate_hi[k], float(uni.tube.t[k]))]
+    assert uni.consistent and out and out[-1] == N - 1
+
+
+def test_unicycle_record_gives_the_unicycle_velocity_bit_for_bit():
+    """A record with ``lateral = [0, 0]`` gives the velocity boxes of ``v (cos psi, sin psi)`` (Eq. 6.23) to
+    the bit, signs of zero included, so the tube of a unicycle record is the one before ``lateral`` existed."""
+    from digslam.observer.slam.digslam import odometry_velocity
+    from digslam.observer.tube.tube import heading_from_compass, unicycle_velocity
+
+    rec, _ = loop_mission(duration=20.0, seed=5)
+    assert not rec.lateral.any()
+    h = heading_from_compass(rec.t, rec.heading[:, 0], rec.heading[:, 1], rec.yaw_rate[1:, 0],
+                             rec.yaw_rate[1:, 1])  # fmt: skip
+    new = odometry_velocity(rec, h)
+    old = unicycle_velocity(rec.speed[1:, 0], rec.speed[1:, 1], h.slice_lo[:, 0], h.slice_hi[:, 0])
+    assert all(a.tobytes() == b.tobytes() for a, b in zip(new, old, strict=True))

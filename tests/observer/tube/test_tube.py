@@ -486,3 +486,51 @@ def test_example_tube_dead_reckoning() -> None:
     assert res["truth_inside"] and res["T"] == 1200
     assert res["contracted_width_max"] <= res["dead_reckoning_width_final"]  # fixes ±0.5 m: no gain in 2 min
     assert res["heading_width_max"] <= 0.002 + 1e-12 and res["heading_width_gyro_only_final"] > 0.2
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    v1=st.tuples(st.floats(-3, 5), st.floats(0, 3)),
+    v2=st.tuples(st.floats(-2, 2), st.floats(0, 2)),
+    psi=st.tuples(st.floats(-20, 20), st.floats(0, 4)),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_body_velocity_contains_rotated_points(v1: tuple, v2: tuple, psi: tuple, seed: int) -> None:
+    """``R(psi) v`` (Eq. 3.59, 6.12, B.20) for sampled ``psi``, ``v = (v_1, v_2)`` (corners included) lies in
+    the box of :func:`body_velocity` (mpmath at 40 digits)."""
+    lo = np.array([[v1[0], v2[0]]])
+    hi = np.array([[v1[0] + v1[1], v2[0] + v2[1]]])
+    p_lo, p_hi = psi[0], psi[0] + psi[1]
+    u_lo, u_hi = body_velocity(lo, hi, [p_lo], [p_hi])
+    rng = np.random.default_rng(seed)
+    pts = [(a, b, p) for a in (lo[0, 0], hi[0, 0]) for b in (lo[0, 1], hi[0, 1]) for p in (p_lo, p_hi)]
+    pts += list(zip(rng.uniform(lo[0, 0], hi[0, 0], 12), rng.uniform(lo[0, 1], hi[0, 1], 12),
+                    rng.uniform(p_lo, p_hi, 12), strict=True))  # fmt: skip
+    with mpmath.workdps(40):
+        for a, b, p in pts:
+            if not (lo[0, 0] <= a <= hi[0, 0] and lo[0, 1] <= b <= hi[0, 1] and p_lo <= p <= p_hi):
+                continue
+            c, s = mpmath.cos(mpmath.mpf(p)), mpmath.sin(mpmath.mpf(p))
+            img = (mpmath.mpf(a) * c - mpmath.mpf(b) * s, mpmath.mpf(a) * s + mpmath.mpf(b) * c)
+            for i in range(2):
+                assert mpmath.mpf(u_lo[0, i]) <= img[i] <= mpmath.mpf(u_hi[0, i])
+
+
+def test_body_velocity_without_lateral_is_the_unicycle_to_the_bit() -> None:
+    """Rows with ``[v_2] = [0, 0]`` are :func:`unicycle_velocity` bit for bit, signs of zero included (the
+    natural form would turn a ``-0.0`` bound into ``+0.0``), whatever the other rows hold."""
+    rng = np.random.default_rng(3)
+    n = 4000
+    v = np.sort(rng.uniform(-2, 2, (2, n)), axis=0)
+    v[:, :500] = 0.0  # zero speeds: products -0.0 against negative cos/sin
+    v[:, 500:1000] = np.sort(rng.choice([-1.0, 0.0, 1.0], (2, 500)), axis=0)
+    p = np.sort(rng.uniform(-7, 7, (2, n)), axis=0)
+    uni = unicycle_velocity(v[0], v[1], p[0], p[1])
+    lat = np.zeros((2, n))
+    got = body_velocity(np.stack([v[0], lat[0]], 1), np.stack([v[1], lat[1]], 1), p[0], p[1])
+    assert all(a.tobytes() == b.tobytes() for a, b in zip(got, uni, strict=True))
+    lat[:, ::2] = [[-0.1], [0.2]]  # mixed: the unicycle rows unchanged, the others wider
+    mix = body_velocity(np.stack([v[0], lat[0]], 1), np.stack([v[1], lat[1]], 1), p[0], p[1])
+    for a, b in zip(mix, uni, strict=True):
+        assert a[1::2].tobytes() == b[1::2].tobytes()
+    assert np.all(mix[0][::2] <= uni[0][::2]) and np.all(mix[1][::2] >= uni[1][::2])

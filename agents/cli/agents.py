@@ -1,0 +1,88 @@
+"""The agents a command runs: ``--agent``/``--agents`` names, the saved PPO models, the frontier fallback.
+
+The model registry (the shipped policy, its environment keywords, loading a ``.zip``) is
+:mod:`digslam.agents.learning.models`; here its :class:`~digslam.agents.learning.models.ModelError` becomes a
+:class:`~digslam.agents.cli.common.UserError` worded with the command's options.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+from typing import Any
+
+from digslam.agents.cli.common import UserError, make_env
+from digslam.agents.learning import models
+
+
+def agent_names() -> list[str]:
+    """Names ``--agent`` takes: ``ppo`` and the baselines."""
+    from digslam.agents.baselines.registry import BASELINES
+
+    return ["ppo", *BASELINES]
+
+
+def model_env_kwargs(model: Path | None = None) -> dict[str, Any]:
+    """:func:`~digslam.agents.learning.models.model_env_kwargs` (None: the shipped policy); a damaged
+    sidecar raises :class:`UserError`."""
+    try:
+        return models.model_env_kwargs(model)
+    except models.ModelError as exc:
+        raise UserError(str(exc)) from None
+
+
+def load_ppo(path: Path, env: Any) -> Any:
+    """The saved PPO model at ``path``, checked against ``env``'s spaces (:class:`UserError` otherwise)."""
+    try:
+        return models.load_ppo(path, env, opt="--model")
+    except models.ModelError as exc:
+        raise UserError(str(exc)) from None
+
+
+def load_agent(name: str, env: Any, model: Path | None = None) -> Any:
+    """A policy with SB3's ``predict``: ``"ppo"`` (a saved PPO model, default the shipped one) or a
+    baseline name of :data:`digslam.agents.baselines.registry.BASELINES`.
+
+    Raises:
+        UserError: unknown ``name``, or a model that cannot be loaded for ``env``.
+    """
+    if name == "ppo":
+        return load_ppo(Path(model) if model is not None else models.PRETRAINED, env)
+    if name not in agent_names():
+        raise UserError(f"--agent {name!r}: unknown agent; known: {', '.join(agent_names())}")
+    from digslam.agents.baselines.registry import make_baseline
+
+    return make_baseline(name, env)
+
+
+def resolve_agent(name: str, env_id: str, model: Path | None) -> tuple[str, Any, dict[str, Any]]:
+    """``(name, policy, env_kwargs)``. A ``--model`` the user names must load (:class:`UserError`
+    otherwise); without one, ``"ppo"`` falls back to ``"frontier"`` (with a warning) when the shipped policy,
+    torch or stable-baselines3 is unavailable."""
+    if name not in agent_names():
+        raise UserError(f"--agent {name!r}: unknown agent; known: {', '.join(agent_names())}")
+    if model is not None and name != "ppo":
+        raise UserError(f"--model: only with --agent ppo (got --agent {name})")
+    pretrained = models.PRETRAINED  # read at call time (tests point it elsewhere)
+    path = Path(model) if model is not None else pretrained
+    kwargs = model_env_kwargs(path) if name == "ppo" else {}
+    env = make_env(env_id, kwargs, f"{path.with_suffix('.json')}" if kwargs else "--env")
+    try:
+        if name == "ppo" and model is None:
+            try:
+                import stable_baselines3  # noqa: F401
+            except ImportError:
+                warnings.warn("the shipped PPO policy needs stable-baselines3 and torch (pip install "
+                              '"digslam[train]"); using the frontier agent', stacklevel=2)  # fmt: skip
+                return "frontier", load_agent("frontier", env), kwargs
+            if not pretrained.is_file():
+                warnings.warn(
+                    f"no shipped PPO policy at {pretrained}; using the frontier agent", stacklevel=2
+                )
+                return "frontier", load_agent("frontier", env), kwargs
+        return name, load_agent(name, env, model), kwargs
+    finally:
+        env.close()
+
+
+__all__ = ["agent_names", "load_agent", "load_ppo", "model_env_kwargs", "resolve_agent"]

@@ -1,0 +1,144 @@
+"""The episode subcommands: ``record`` (an agent's episode to a ``.npz``) and ``replay`` (check it, re-run the
+offline Dig-SLAM observer on it).
+
+:func:`load_episode` turns every way an episode file can be wrong into one
+:class:`~digslam.agents.cli.common.UserError` line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+from typing import Any
+
+from digslam.agents.cli.agents import resolve_agent
+from digslam.agents.cli.common import UserError, check_env_id, commit, first_line, make_env, out_path, staged
+
+
+def cmd_record(args: argparse.Namespace) -> int:
+    """``digslam record``: run an agent for ``--steps`` and save the episode (``.npz``)."""
+    import numpy as np
+
+    from digslam.envs.explore.episode import Episode, GroundTruth
+    from digslam.observer.slam.record import MissionRecord
+
+    check_env_id(args.env, "record")
+    out = Path(args.out)
+    out_path(out, "--out", folder=False)
+    if out.suffix != ".npz":  # numpy would add it anyway: say so by writing the name we print
+        out = out.with_name(out.name + ".npz")
+    out = out_path(out, "--out", folder=False)
+    name, policy, kwargs = resolve_agent(args.agent, args.env, args.model)
+    env = make_env(args.env, kwargs, "--env", max_episode_steps=args.steps)
+    try:
+        obs, info = env.reset(seed=args.seed)
+        recs, truths, actions = [info["record"]], [info["truth"]], []
+        bar = None
+        if args.progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=args.steps, desc=f"record {name}")
+        for _ in range(args.steps):
+            a, _ = policy.predict(obs, deterministic=True)
+            a = np.asarray(a, dtype=np.float32).reshape(2)
+            obs, _, term, trunc, info = env.step(a)
+            actions.append(a)
+            recs.append(info["record"])
+            truths.append(info["truth"])
+            if bar is not None:
+                bar.update()
+            if term or trunc:
+                break
+        if bar is not None:
+            bar.close()
+        ep = Episode(env.unwrapped.config, int(args.seed), np.array(actions, np.float32).reshape(-1, 2),
+                     MissionRecord.stack(recs), GroundTruth.stack(truths))  # fmt: skip
+    finally:
+        env.close()
+    with staged(out.parent) as tmp:
+        ep.save(tmp / out.name)
+        commit({tmp / out.name: out})
+    print(f"agent {name}: {len(ep.actions)} steps, certified coverage {info['certified_coverage']:.3f}; "
+          f"wrote {out}")  # fmt: skip
+    return 0
+
+
+def same_episode(a: Any, b: Any) -> bool:
+    """Whether two episodes have the same actions, measurement records and ground truth."""
+    import numpy as np
+
+    ra, rb = a.records.to_arrays(), b.records.to_arrays()
+    return (
+        np.array_equal(a.actions, b.actions)
+        and ra.keys() == rb.keys()
+        and all(np.array_equal(ra[k], rb[k], equal_nan=True) for k in ra)
+        and a.truth == b.truth
+    )
+
+
+def load_episode(path: str | Path) -> Any:
+    """:meth:`Episode.load` with every way a file can be wrong turned into one :class:`UserError` line."""
+    import zipfile
+
+    from digslam.envs.explore.episode import Episode
+
+    p = Path(path)
+    fix = "give an episode .npz written by `digslam record`"
+    if not p.exists():
+        raise UserError(f"{p}: no such file; {fix} (e.g. digslam record --out {p})")
+    if p.is_dir():
+        raise UserError(f"{p}: is a folder; {fix}")
+    if not os.access(p, os.R_OK):
+        raise UserError(f"{p}: cannot read it (permission denied)")
+    if not zipfile.is_zipfile(p):
+        raise UserError(f"{p}: not an .npz archive; {fix}")
+    try:
+        return Episode.load(p)
+    except KeyError as exc:
+        why = f"no {exc.args[0]!r} array" if exc.args else "an array is missing"
+    except zipfile.BadZipFile as exc:
+        why = f"damaged archive: {first_line(exc)}"
+    except ValueError as exc:
+        why = "it holds pickled objects" if "pickle" in str(exc) else first_line(exc)
+    except (OSError, EOFError, TypeError, AttributeError, IndexError) as exc:
+        why = f"{type(exc).__name__}: {first_line(exc)}"
+    raise UserError(f"{p}: not an episode ({why}); {fix}")
+
+
+def cmd_replay(args: argparse.Namespace) -> int:
+    """``digslam replay FILE``: replay an episode, check it is identical (exit 1 if not), ``--digslam``."""
+    import numpy as np
+
+    from digslam.envs.explore.episode import replay
+
+    ep = load_episode(args.file)
+    try:
+        again = replay(ep)
+    except ValueError as exc:
+        raise UserError(f"{args.file}: cannot be replayed ({first_line(exc)}); {args.file} is damaged or "
+                        "from another version; record it again") from None  # fmt: skip
+    ok = same_episode(ep, again)
+    print(f"{args.file}: {len(ep.actions)} steps, seed {ep.seed}; replay identical: {ok}")
+    if args.digslam:
+        from digslam.observer.slam.digslam import DigSlamConfig, dig_slam
+        from digslam.observer.slam.grid import Grid
+
+        s = float(ep.config.world_size)
+        grid = Grid((-s, -s), (s, s), (args.grid, args.grid))
+        start = ep.truth.pose[0, :2]
+        res = dig_slam(ep.records, grid, start, start, DigSlamConfig(max_iter=args.max_iter))
+        if not res.consistent:
+            print(f"dig_slam: inconsistent at gate {res.first_empty}")
+        else:
+            w = res.tube.widths()
+            inside = bool(np.all(res.tube.contains(ep.records.t, ep.truth.pose[:, :2])))
+            dr = res.dead_reckoning
+            dr_txt = f"{float(np.max(dr)):.3f}" if dr is not None else "n/a"
+            print(f"dig_slam: {res.iterations} iterations; tube width max {float(np.max(w)):.3f} m, "
+                  f"final {float(np.ravel(w)[-1]):.3f} m (dead reckoning max {dr_txt} m); "
+                  f"truth inside the tube: {inside}")  # fmt: skip
+    return 0 if ok else 1
+
+
+__all__ = ["cmd_record", "cmd_replay", "load_episode", "same_episode"]

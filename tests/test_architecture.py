@@ -1,0 +1,193 @@
+"""The architecture's rules, checked on the source (``tests/architecture.py`` reads it with ``ast``).
+
+The rules are written in the folders' docstrings (``digslam.observer.core`` holds the kernel rules); these
+tests fail when the code stops following them.
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import re
+import warnings
+from pathlib import Path
+
+import pytest
+from architecture import REPO, cycles, graph, scan, third_party
+
+MODS = scan()
+
+#: What each concept folder may import (its docstring's "May import"); a folder may always import itself.
+ALLOWED: dict[str, set[str]] = {
+    "observer.core": set(),
+    "observer.expr": {"observer.core"},
+    "observer.sets": {"observer.core", "observer.expr"},
+    "observer.paving": {"observer.core", "observer.sets"},
+    "observer.polar": {"observer.core", "observer.expr", "observer.sets"},
+    "observer.thick": {"observer.core", "observer.expr", "observer.sets", "observer.paving"},
+    "observer.tube": {"observer.core"},
+    "observer.slam": {"observer.core", "observer.expr", "observer.sets", "observer.paving", "observer.polar",
+                      "observer.thick", "observer.tube"},
+    "observer.online": {"observer.core", "observer.slam", "observer.thick"},
+    "envs.sim": {"observer.core", "observer.slam", "envs"},
+    "envs.explore": {"observer.core", "observer.slam", "envs.sim", "envs"},
+    "envs.dig_coverage": {"observer.core", "observer.slam", "observer.thick", "observer.online", "envs.sim",
+                          "envs.explore", "envs"},
+    "agents.baselines": {"observer.core", "envs"},
+    "agents.learning": {"observer.core", "envs", "agents.baselines", "agents.evaluation"},
+    "agents.evaluation": {"observer.core", "observer.thick", "envs", "envs.sim", "envs.explore",
+                          "envs.dig_coverage", "agents.baselines", "agents.learning"},
+}  # fmt: skip
+FOLDERS = sorted(m.name for m in MODS.values() if m.is_package and m.name.count(".") == 1)
+
+
+def test_every_concept_folder_is_listed_and_documented() -> None:
+    assert set(FOLDERS) - {"agents.cli"} == set(ALLOWED), "a new folder needs its rules here and a docstring"
+    for name in FOLDERS:
+        doc = ast.get_docstring(MODS[name].tree) or ""
+        assert "Lives here" in doc and "May import" in doc, (
+            f"{name}/__init__.py: say what lives there and what it may import"
+        )
+
+
+def test_no_folder_holds_more_than_15_modules() -> None:
+    for name in FOLDERS:
+        n = sum(1 for m in MODS.values() if m.folder == name and not m.is_package)
+        assert n <= 15, f"{name}: {n} modules"
+
+
+def test_folders_import_only_what_their_docstring_allows() -> None:
+    bad = []
+    for m in MODS.values():
+        folder = m.folder
+        if folder not in ALLOWED:
+            continue
+        for target, _, line, _ in m.imports:
+            tfolder = MODS[target].folder if target in MODS else target
+            if tfolder == folder or tfolder.startswith(folder + "."):
+                continue
+            if tfolder not in ALLOWED[folder]:
+                bad.append(f"{m.path.relative_to(REPO)}:{line} imports {target}")
+    assert not bad, "\n".join(bad)
+
+
+def test_no_import_cycle_including_imports_inside_functions() -> None:
+    assert cycles(graph(MODS)) == []
+
+
+def test_no_private_name_is_imported_across_modules() -> None:
+    bad = [f"{m.path.relative_to(REPO)}:{line} imports {name} from {target}"
+           for m in MODS.values() for target, name, line, _ in m.imports
+           if name and name.startswith("_") and target != m.name]  # fmt: skip
+    assert not bad, "\n".join(bad)
+
+
+def test_kernels_are_defined_only_in_jit_files() -> None:
+    bad = [m.name for m in MODS.values() if m.kernels and not m.name.endswith("_jit")]
+    assert not bad, f"move these kernels into a <topic>_jit.py file: {bad}"
+
+
+def test_a_kernel_file_calls_only_its_own_folder_and_the_core() -> None:
+    bad = []
+    for m in MODS.values():
+        if not m.name.endswith("_jit"):
+            continue
+        for target, name, line, _ in m.imports:
+            src = MODS.get(target)
+            if src is None or name is None or name not in src.kernels:
+                continue
+            if src.folder not in (m.folder, "observer.core"):
+                bad.append(f"{m.path.relative_to(REPO)}:{line} calls {target}.{name}")
+    assert not bad, "\n".join(bad)
+
+
+def test_the_kernel_rule_test_catches_a_cross_folder_call(tmp_path: Path) -> None:
+    """The checker itself: a kernel file that imports a kernel of another non-core folder is reported."""
+    from architecture import Module
+
+    src = Module("observer.online.dig_jit", tmp_path / "a.py", False, ast.parse(""), kernels={"window"})
+    bad = Module("envs.sim.x_jit", tmp_path / "b.py", False, ast.parse(""),
+                 imports=[("observer.online.dig_jit", "window", 1, False)])  # fmt: skip
+    offenders = [name for _, name, _, _ in bad.imports
+                 if name in src.kernels and src.folder not in (bad.folder, "observer.core")]  # fmt: skip
+    assert offenders == ["window"]
+
+
+def test_observer_needs_only_numpy_scipy_numba() -> None:
+    allowed = {"numpy", "scipy", "numba", "matplotlib", "mpmath"}  # matplotlib: paving.draw, on use only
+    stdlib = set(__import__("sys").stdlib_module_names)
+    for m in MODS.values():
+        if m.name.startswith("observer"):
+            extra = third_party(m) - allowed - stdlib
+            assert not extra, f"{m.name} imports {extra}"
+
+
+# --- documented paths --------------------------------------------------------------------------------
+README = (REPO / "README.md").read_text()
+DOCUMENTED = sorted(set(re.findall(r"\bdigslam\.(?:observer|envs|agents)(?:\.[a-z_]+)+", README)))
+OLD_PATHS = [
+    "online",
+    "explored",
+    "thick_carving",
+    "landmarks",
+    "shape_slam",
+    "shapes",
+    "rounding",
+    "testing",
+    "jit",
+]
+
+
+@pytest.mark.parametrize("pkg", ["digslam.observer", "digslam.envs", "digslam.agents"])
+def test_every_listed_name_imports(pkg: str) -> None:
+    mod = importlib.import_module(pkg)
+    for name in mod.__all__:
+        assert getattr(mod, name) is not None, f"{pkg}.{name}"
+
+
+@pytest.mark.parametrize("path", DOCUMENTED)
+def test_every_path_in_the_readme_imports(path: str) -> None:
+    parts = path.split(".")
+    for cut in range(len(parts), 1, -1):  # the longest importable prefix, then attributes
+        try:
+            obj = importlib.import_module(".".join(parts[:cut]))
+        except ModuleNotFoundError:
+            continue
+        for attr in parts[cut:]:
+            obj = getattr(obj, attr)
+        return
+    pytest.fail(f"{path} does not import")
+
+
+@pytest.mark.parametrize("old", OLD_PATHS)
+def test_the_old_documented_module_paths_still_work(old: str) -> None:
+    import digslam.observer as observer
+
+    full = f"digslam.observer.{old}"
+    new = observer.compat.OBSERVER.get(old)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        mod = importlib.import_module(full)
+    if new is None:  # still a real path (a folder now): no warning
+        assert mod.__name__ == full
+        return
+    assert mod is importlib.import_module(f"digslam.observer.{new}")
+    assert any(issubclass(w.category, DeprecationWarning) and new in str(w.message) for w in caught) or (
+        full in __import__("sys").modules
+    )
+
+
+@pytest.mark.parametrize(
+    "pkg, table",
+    [("digslam.observer", "compat.OBSERVER"), ("digslam.envs", "MOVED"), ("digslam.agents", "MOVED")],
+)
+def test_every_moved_module_resolves_to_its_new_home(pkg: str, table: str) -> None:
+    base = importlib.import_module(pkg)
+    moved = base
+    for attr in table.split("."):
+        moved = getattr(moved, attr)
+    for old, new in moved.items():
+        target = new if new.startswith("digslam.") else f"{pkg}.{new}"
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)
+            assert importlib.import_module(f"{pkg}.{old}") is importlib.import_module(target), old
