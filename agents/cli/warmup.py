@@ -28,9 +28,10 @@ def _robot() -> None:
 
     from digslam.envs.explore.env import ExploreEnv
 
-    env = ExploreEnv()
-    env.reset(seed=0)
-    env.step(np.array([1.0, 0.5], np.float32))
+    for dynamics in ("pymunk", "unicycle"):  # both robots' kernels
+        env = ExploreEnv(dynamics=dynamics)
+        env.reset(seed=0)
+        env.step(np.array([1.0, 0.5], np.float32))
 
 
 def _observer() -> None:

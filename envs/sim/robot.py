@@ -13,19 +13,24 @@ kinematic control body pulls it through a ``PivotJoint`` (``max_bias = 0``: a pu
 ``max_force``: the drive's force limit, so the body has inertia and lags the command) and a ``GearJoint``
 (``max_bias = 0``, ``max_force = max_torque``). Each substep the control body's velocity is set from the
 command ``(v, omega)`` in the body frame: ``v`` along the body's current heading, ``omega`` its angular
-velocity. Walls are static ``pymunk.Segment`` s with friction (:data:`WALL_FRICTION`) and no elasticity, so
-the robot skids along them and friction turns it; contacts are pymunk's. The collision circle has radius
+velocity. Walls are static ``pymunk.Segment`` shapes with friction (:data:`WALL_FRICTION`) and no
+elasticity, so the robot skids along them and friction turns it; contacts are pymunk's. (An earlier version
+drove the robot so with a unicycle record: the body's velocity lagged its heading, by up to 0.5 rad on
+reversals, and slid along walls, motions no unicycle with the recorded heading explains. The record's
+lateral velocity and the rigorous hulls below close that gap.) The collision circle has radius
 ``radius + skin``. A step of ``dt`` seconds runs ``substeps`` pymunk steps whose durations are exact floats
 summing exactly to ``dt`` (:func:`.dynamics_jit.substep_times`). The truth is the piecewise-linear path
 through the states read back after each substep (:mod:`.dynamics_jit`: exact by definition, so
 ``pose_error = 0``); its body-frame velocity and yaw rate are bounded rigorously over the step
-(:func:`.dynamics_jit.step_bounds`). **The premise by construction**: after every substep the disc of radius
-``radius`` centred anywhere on the segment from the previous state must be proved off every wall
-(:func:`.dynamics_jit.substep_clear`, rigorous float geometry that also catches tunnelling through thin
-walls). If it is not, the substep is undone: the body goes back to the previous state with zero velocity
-and angular velocity (a hard stop) and :attr:`~RobotSim.stops` counts it. The skin keeps pymunk's contacts
-off the disc, so hard stops are rare (``tests/envs/sim/test_dynamics.py``). A bump is a contact that begins
-while the robot touched no wall (pymunk's collision ``begin``).
+(:func:`.dynamics_jit.step_bounds`); the heading over the step lies in the hull of the substep headings and
+moves linearly between them, at a rate inside the yaw-rate hull. **The premise by construction**: after
+every substep the disc of radius ``radius`` centred anywhere on the segment from the previous state must be
+proved off every wall (:func:`.dynamics_jit.substep_clear`, rigorous float geometry that also catches
+tunnelling through thin walls; away from walls the cheaper :func:`.dynamics_jit.free_radius` proves it for
+the whole step). If it is not, the substep is undone: the body goes back to the previous state with zero
+velocity and angular velocity (a hard stop) and :attr:`~RobotSim.stops` counts it. The skin keeps pymunk's
+contacts off the disc, so hard stops are rare (``tests/envs/sim/test_dynamics.py``). A bump is a contact
+that begins while the robot touched no wall (pymunk's collision ``begin``).
 
 **unicycle** (``dynamics="unicycle"``, the thesis's missions' model). Exact unicycle kinematics, blocked
 (never sliding) by the world's walls: the robot follows the exact arcs of :mod:`.arc_jit` at constant speed
@@ -112,12 +117,8 @@ class RobotSim:
         self.body = pymunk.Body(mass, pymunk.moment_for_circle(mass, 0, radius))
         self.body.position = (float(pose[0]), float(pose[1]))
         self.body.angle = float(pose[2])
-        self.shape = pymunk.Circle(self.body, radius + skin)
-        self.shape.collision_type, self.shape.friction, self.shape.elasticity = (
-            ROBOT_TYPE,
-            ROBOT_FRICTION,
-            0.0,
-        )
+        self.shape = shape = pymunk.Circle(self.body, radius + skin)
+        shape.collision_type, shape.friction, shape.elasticity = ROBOT_TYPE, ROBOT_FRICTION, 0.0
         self.control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
         self.control.position, self.control.angle = self.body.position, self.body.angle
         pivot = pymunk.PivotJoint(self.control, self.body, (0, 0), (0, 0))
@@ -141,6 +142,8 @@ class RobotSim:
         #: The last step's pieces ``(v, tau, theta_end)`` (:mod:`.arc_jit`; unicycle; NaN under pymunk); at
         #: reset, at rest.
         self.pieces = np.array([[0.0, 0.0, self._pose[2]], [0.0, 0.0, self._pose[2]]])
+        if dynamics == "pymunk":
+            self.pieces = _NAN_PIECES
         #: The last step's path (pymunk): the states ``(S + 1, 3)`` (``x, y, angle`` before the step and
         #: after each substep) and the substep durations ``(S,)``; empty before the first step and under the
         #: unicycle. Fresh arrays each step, never written afterwards.
@@ -198,8 +201,9 @@ class RobotSim:
             x1, y1 = _GET_P(body)
             a1 = _GET_A(body)
             near = (abs(x1 - x0) + abs(y1 - y0)) * _GROW < free  # |p1 - p0| < free, rounding included
-            if not (inside and near) and not substep_clear(x, y, x1, y1, radius, edges, bbox):
-                self.stops += 1  # undo the substep: a hard stop
+            ok = a1 - a1 == 0.0 and ((inside and near) or substep_clear(x, y, x1, y1, radius, edges, bbox))
+            if not ok:  # (a NaN or infinite state is never ok) undo the substep: a hard stop
+                self.stops += 1
                 x1, y1, a1, near = x, y, a, inside
                 body.position, body.angle = (x, y), a
                 body.velocity, body.angular_velocity = (0.0, 0.0), 0.0
@@ -218,7 +222,6 @@ class RobotSim:
         c, s = math.cos(a), math.sin(a)
         self._v, self._lat, self._w = c * ux + s * uy, c * uy - s * ux, (a - ap) / tau
         self.states, self.taus = states, taus
-        self.pieces = _NAN_PIECES
         return self.bumps - bumps
 
     def _step_unicycle(self, v: float, omega: float, dt: float, substeps: int) -> int:

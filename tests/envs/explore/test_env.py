@@ -140,6 +140,42 @@ def test_recorded_episode_replays_to_identical_records(tmp_path: Path) -> None:
     assert MissionRecord.load_npz(tmp_path / "rec.npz") == ep.records
 
 
+def test_an_episode_saved_before_pymunk_dynamics_loads_as_a_unicycle(tmp_path: Path) -> None:
+    """An episode file without the config's ``dynamics``, the truth's ``lateral``, ``states`` and ``taus`` and
+    the record's ``lateral`` (saved before they existed, by the unicycle) loads with their old meaning and
+    replays to the same records."""
+    import json
+
+    ep = record_episode(ExploreEnv(world="rocks", dynamics="unicycle"), 4, _actions(30, 1))
+    ep.save(tmp_path / "new.npz")
+    with np.load(tmp_path / "new.npz") as z:
+        data = dict(z)
+    cfg = json.loads(str(data["config"]))
+    del cfg["dynamics"]
+    data["config"] = np.array(json.dumps(cfg))
+    for key in ("truth_lateral", "truth_states", "truth_taus", "record_lateral"):
+        del data[key]
+    np.savez(tmp_path / "old.npz", **data)
+    old = Episode.load(tmp_path / "old.npz")
+    assert old.config.dynamics == "unicycle" and old.records == ep.records and old.truth == ep.truth
+    assert old.truth.states.shape == (31, 0, 3) and old.truth.taus.shape == (31, 0)
+    again = replay(old)
+    assert again.records == ep.records and again.truth == ep.truth
+
+
+def test_pymunk_episode_keeps_its_path_and_lateral_velocity() -> None:
+    env = ExploreEnv(world="rooms")
+    assert env.config.dynamics == "pymunk" and env.observation_space["odometry"].shape == (3, 2)
+    ep = record_episode(env, 2, _actions(40, 2))
+    truth, rec = ep.truth, ep.records
+    assert truth.states.shape == (41, 5, 3) and truth.taus.shape == (41, 4)
+    assert np.array_equal(truth.states[1:, 0], truth.states[:-1, -1])  # each step starts where the last ended
+    assert np.array_equal(truth.states[:, -1], truth.pose) and np.all(truth.pose_error == 0)
+    assert np.all(np.isnan(truth.pieces))
+    assert np.all(rec.lateral[:, 0] <= truth.lateral) and np.all(truth.lateral <= rec.lateral[:, 1])
+    assert np.any(rec.lateral[1:, 1] - rec.lateral[1:, 0] > 0.0)
+
+
 def test_render_modes(tmp_path: Path) -> None:
     env = gym.make("digslam/ExploreRooms-v0", render_mode="rgb_array")
     env.reset(seed=0)
@@ -182,6 +218,8 @@ def test_bad_input_errors_name_the_field() -> None:
         gym.make("digslam/Explore-v0", noise={"range": -0.01})
     with pytest.raises(ValueError, match="world"):
         ExploreConfig(world="moon")
+    with pytest.raises(ValueError, match="dynamics"):
+        ExploreConfig(dynamics="tank")
     with pytest.raises(ValueError, match="map_path"):
         ExploreConfig(world="file")
     env = gym.make("digslam/Explore-v0")

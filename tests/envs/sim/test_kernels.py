@@ -287,7 +287,8 @@ def test_observation_matches_numpy_oracle(dynamics: str) -> None:
         if k % 3 == 0:  # headings far from [-pi, pi], odometry beyond the clip
             rec.heading[:] += 2 * np.pi * rng.integers(-5, 6) + [0.0, 1e-3]
             rec.speed[:] *= rng.choice([1.0, 1e3])
-            rec.lateral[:] = rec.lateral * rng.choice([1.0, 1e3]) + np.array([-1.0, 1.0]) * rng.choice([0.0, 50.0])
+            spread = np.array([-1.0, 1.0]) * rng.choice([0.0, 50.0])
+            rec.lateral[:] = rec.lateral * rng.choice([1.0, 1e3]) + spread
             obs = env._obs(rec)
         h = rec.heading
         kk = np.round(0.5 * (h[0] + h[1]) / (2 * math.pi)) * 2 * math.pi

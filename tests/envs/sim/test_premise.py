@@ -1,7 +1,8 @@
 """The premise of the guarantee, checked: every recorded interval contains the independently recomputed truth.
 
-:mod:`premise` recomputes the motion in mpmath (200 bits) from ``truth.pieces`` and the ranges by brute-force
-cone geometry from ``world.edges``; these tests run it over hostile action sequences (tiny, subnormal,
+:mod:`premise` recomputes the motion exactly (mpmath, 200 bits, from ``truth.pieces`` under the unicycle;
+``Fraction`` and mpmath from ``truth.states`` under pymunk) and the ranges by brute-force cone geometry from
+``world.edges``; these tests run it, under both dynamics, over hostile action sequences (tiny, subnormal,
 huge-but-valid and sign-alternating yaw actions), zero noise bounds, the adversarial noise model and robots
 pressed against walls, and check that the checker itself catches corrupted records.
 """
@@ -48,13 +49,13 @@ YAWS = (
 SPEEDS = (0.0, 1.0, -1.0, 0.5, 1e-12, 5e-324, 1.0 + 5e-7)
 FAST = settings(max_examples=10, deadline=None, derandomize=True,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])  # fmt: skip
-_ENVS: dict[tuple[str, str], ExploreEnv] = {}
+_ENVS: dict[tuple[str, str, str], ExploreEnv] = {}
 
 
-def _env(world: str, noise: str) -> ExploreEnv:
-    key = (world, noise)
+def _env(world: str, noise: str, dynamics: str = "pymunk") -> ExploreEnv:
+    key = (world, noise, dynamics)
     if key not in _ENVS:
-        _ENVS[key] = ExploreEnv(world=world, noise=NOISES[noise], n_obstacles=12)
+        _ENVS[key] = ExploreEnv(world=world, noise=NOISES[noise], n_obstacles=12, dynamics=dynamics)
     return _ENVS[key]
 
 
@@ -101,6 +102,7 @@ def test_cone_distances_closed_forms() -> None:
 
 
 # --- property tests over hostile actions -------------------------------------------------------------------
+@pytest.mark.parametrize("dynamics", ["pymunk", "unicycle"])
 @FAST
 @given(world=st.sampled_from(["room", "rocks"]), noise=st.sampled_from(sorted(NOISES)),
        seed=st.integers(960000, 960999), actions=_actions())  # fmt: skip
@@ -108,15 +110,19 @@ def test_cone_distances_closed_forms() -> None:
     world="room", noise="adversarial", seed=960000, actions=[(5e-324, 0.0)]
 )  # a subnormal speed: it once
 @example(world="rocks", noise="zero", seed=960201, actions=[(1.0, 2e-12)] * 3)  # broke the simulator's bound
-def test_premise_holds_for_hostile_actions(world: str, noise: str, seed: int, actions: list) -> None:
-    chk = check_episode(_env(world, noise), seed, actions)
+def test_premise_holds_for_hostile_actions(
+    world: str, noise: str, seed: int, actions: list, dynamics: str
+) -> None:
+    env = _env(world, noise, dynamics)
+    chk = check_episode(env, seed, actions, radius=env.config.robot_radius)
     assert chk.k == len(actions)
 
 
+@pytest.mark.parametrize("dynamics", ["pymunk", "unicycle"])
 @FAST
 @given(seed=st.integers(960000, 960999), yaw=st.sampled_from(YAWS), n=st.integers(3, 12))
-def test_premise_holds_for_constant_tiny_yaws(seed: int, yaw: float, n: int) -> None:
-    check_episode(_env("rocks", "adversarial-zero"), seed, [(1.0, yaw)] * n)
+def test_premise_holds_for_constant_tiny_yaws(seed: int, yaw: float, n: int, dynamics: str) -> None:
+    check_episode(_env("rocks", "adversarial-zero", dynamics), seed, [(1.0, yaw)] * n)
 
 
 def _facing_nearest_wall(env: ExploreEnv, seed: int) -> tuple[float, float, float]:
