@@ -20,7 +20,11 @@ another library did (codac switches the whole process to upward rounding; run it
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+
+from digslam.observer.core.types import Floats
 
 __all__ = [
     "LIBM_ULPS",
@@ -72,7 +76,7 @@ _MAG = np.int64(2**63 - 1)
 _INF_BITS = np.int64(0x7FF0000000000000)
 
 
-def next_up(x: np.ndarray, ulps: int = 1) -> np.ndarray:
+def next_up(x: Floats, ulps: int = 1) -> np.ndarray:
     """The float ``ulps`` steps above ``x`` (``+inf`` stays ``+inf``, NaN stays NaN).
 
     Same result as ``ulps`` calls of ``np.nextafter(x, inf)``, several times faster: the bit pattern
@@ -87,26 +91,26 @@ def next_up(x: np.ndarray, ulps: int = 1) -> np.ndarray:
     return np.where(nan, y, r) if nan.any() else r
 
 
-def next_down(x: np.ndarray, ulps: int = 1) -> np.ndarray:
+def next_down(x: Floats, ulps: int = 1) -> np.ndarray:
     """The float ``ulps`` steps below ``x`` (``-inf`` stays ``-inf``)."""
     return -next_up(-np.asarray(x, dtype=np.float64), ulps)
 
 
-def widen_down(x: np.ndarray, ulps: int = LIBM_ULPS) -> np.ndarray:
+def widen_down(x: Floats, ulps: int = LIBM_ULPS) -> np.ndarray:
     """Move ``x`` down by ``ulps`` ulps: a lower bound for a value computed within ``ulps`` ulps."""
     return next_down(x, ulps)
 
 
-def widen_up(x: np.ndarray, ulps: int = LIBM_ULPS) -> np.ndarray:
+def widen_up(x: Floats, ulps: int = LIBM_ULPS) -> np.ndarray:
     """Move ``x`` up by ``ulps`` ulps: an upper bound for a value computed within ``ulps`` ulps."""
     return next_up(x, ulps)
 
 
-def _overflowed(r: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def _overflowed(r: Any, a: Any, b: Any) -> np.ndarray:
     return np.isinf(r) & np.isfinite(a) & np.isfinite(b)
 
 
-def _sum_error(a: np.ndarray, b: np.ndarray, s: np.ndarray) -> np.ndarray:
+def _sum_error(a: Any, b: Any, s: Any) -> np.ndarray:
     """TwoSum (Knuth): exact ``a + b - s``; NaN where an operand is infinite."""
     bb = s - a
     return (a - (s - bb)) + (b - bb)
@@ -120,7 +124,7 @@ _ETA = 2.0**-1074
 _NEAR_SUBNORMAL = 2.0**-1019  # where fl(c ± (φ|c| + η)) can skip a float
 
 
-def _step(r: np.ndarray, mask: np.ndarray, up: bool) -> np.ndarray:
+def _step(r: Any, mask: Any, up: bool) -> np.ndarray:
     """Exactly one ulp outward where ``mask``: 4 array passes, plus the exact integer step for the rare
     values near the smallest normal where the formula may go two ulps."""
     with np.errstate(over="ignore", invalid="ignore"):
@@ -132,7 +136,7 @@ def _step(r: np.ndarray, mask: np.ndarray, up: bool) -> np.ndarray:
         return out
 
 
-def step_up(r: np.ndarray) -> np.ndarray:
+def step_up(r: Floats) -> np.ndarray:
     """An upper bound of the exact value whose round-to-nearest result is ``r``.
 
     For ``r`` the numpy result of one correctly rounded ``+ - * /`` or ``sqrt`` (within half an ulp of the
@@ -152,18 +156,18 @@ def step_up(r: np.ndarray) -> np.ndarray:
     return out
 
 
-def step_down(r: np.ndarray) -> np.ndarray:
+def step_down(r: Floats) -> np.ndarray:
     """A lower bound of the exact value whose round-to-nearest result is ``r`` (see :func:`step_up`)."""
     return -step_up(-np.asarray(r, dtype=np.float64))
 
 
-def _direct(r: np.ndarray, err: np.ndarray, up: bool) -> np.ndarray:
+def _direct(r: Any, err: Any, up: bool) -> np.ndarray:
     """Rounded result ``r`` of an exact value ``r + err``: step one ulp when ``err`` is on that side."""
     with np.errstate(invalid="ignore"):
         return _step(r, (err > 0) if up else (err < 0), up)
 
 
-def _add(a: np.ndarray, b: np.ndarray, up: bool) -> np.ndarray:
+def _add(a: Any, b: Any, up: bool) -> np.ndarray:
     with np.errstate(invalid="ignore", over="ignore"):
         s = np.add(a, b)
         r = _direct(s, _sum_error(a, b, s), up)
@@ -172,40 +176,40 @@ def _add(a: np.ndarray, b: np.ndarray, up: bool) -> np.ndarray:
         return r
 
 
-def add_down(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def add_down(a: Floats, b: Floats) -> np.ndarray:
     """Largest float <= the exact ``a + b`` (``inf - inf`` gives NaN; callers mask it)."""
     return _add(a, b, up=False)
 
 
-def add_up(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def add_up(a: Floats, b: Floats) -> np.ndarray:
     """Smallest float >= the exact ``a + b``."""
     return _add(a, b, up=True)
 
 
-def sub_down(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def sub_down(a: Floats, b: Floats) -> np.ndarray:
     """Largest float <= the exact ``a - b``."""
     return add_down(a, np.negative(b))
 
 
-def sub_up(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def sub_up(a: Floats, b: Floats) -> np.ndarray:
     """Smallest float >= the exact ``a - b``."""
     return add_up(a, np.negative(b))
 
 
-def _split(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _split(a: Any) -> tuple[np.ndarray, np.ndarray]:
     c = _SPLIT * a
     hi = c - (c - a)
     return hi, a - hi
 
 
-def _product_error(a: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:
+def _product_error(a: Any, b: Any, p: Any) -> np.ndarray:
     """Dekker's TwoProduct: exact ``a * b - p`` where no operand or result is huge or tiny."""
     ah, al = _split(a)
     bh, bl = _split(b)
     return ((ah * bh - p) + ah * bl + al * bh) + al * bl
 
 
-def _safe(*vals: np.ndarray) -> np.ndarray:
+def _safe(*vals: Any) -> np.ndarray:
     """Where the error-free transformations are exact: every operand and the result are finite with
     magnitude in ``[2⁻⁹⁶⁰, 2⁹⁹⁵]`` (no overflow in Dekker's split, no bits lost to underflow)."""
     ok = np.ones(np.shape(vals[0]), dtype=bool)
@@ -215,13 +219,13 @@ def _safe(*vals: np.ndarray) -> np.ndarray:
     return ok
 
 
-def _finish(r: np.ndarray, err: np.ndarray, ok: np.ndarray, exact: np.ndarray, up: bool) -> np.ndarray:
+def _finish(r: Any, err: Any, ok: Any, exact: Any, up: bool) -> np.ndarray:
     """Directed result: tight where ``ok``, exact where ``exact``, else one ulp outward."""
     with np.errstate(invalid="ignore"):
         return _step(r, np.where(ok, (err > 0) if up else (err < 0), ~exact), up)
 
 
-def _mul(a: np.ndarray, b: np.ndarray, up: bool) -> np.ndarray:
+def _mul(a: Any, b: Any, up: bool) -> np.ndarray:
     with np.errstate(invalid="ignore", over="ignore", under="ignore"):
         p = np.multiply(a, b)
         ok = _safe(p, a, b)
@@ -238,17 +242,17 @@ def _mul(a: np.ndarray, b: np.ndarray, up: bool) -> np.ndarray:
         return r
 
 
-def mul_down(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def mul_down(a: Floats, b: Floats) -> np.ndarray:
     """Largest float <= the exact ``a * b`` (``0 * inf`` gives NaN; callers mask it)."""
     return _mul(a, b, up=False)
 
 
-def mul_up(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def mul_up(a: Floats, b: Floats) -> np.ndarray:
     """Smallest float >= the exact ``a * b``."""
     return _mul(a, b, up=True)
 
 
-def _div(a: np.ndarray, b: np.ndarray, up: bool) -> np.ndarray:
+def _div(a: Any, b: Any, up: bool) -> np.ndarray:
     with np.errstate(invalid="ignore", over="ignore", under="ignore", divide="ignore"):
         q = np.divide(a, b)
         ok = _safe(q, a, b)
@@ -265,17 +269,17 @@ def _div(a: np.ndarray, b: np.ndarray, up: bool) -> np.ndarray:
         return r
 
 
-def div_down(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def div_down(a: Floats, b: Floats) -> np.ndarray:
     """Largest float <= the exact ``a / b`` for ``b != 0``."""
     return _div(a, b, up=False)
 
 
-def div_up(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def div_up(a: Floats, b: Floats) -> np.ndarray:
     """Smallest float >= the exact ``a / b`` for ``b != 0``."""
     return _div(a, b, up=True)
 
 
-def _sqrt(a: np.ndarray, up: bool) -> np.ndarray:
+def _sqrt(a: Any, up: bool) -> np.ndarray:
     with np.errstate(invalid="ignore", under="ignore"):
         s = np.sqrt(a)
         ok = _safe(s, a)
@@ -286,11 +290,11 @@ def _sqrt(a: np.ndarray, up: bool) -> np.ndarray:
         return _finish(s, err, ok, exact, up)
 
 
-def sqrt_down(a: np.ndarray) -> np.ndarray:
+def sqrt_down(a: Floats) -> np.ndarray:
     """Largest float <= the exact square root of ``a >= 0``."""
     return _sqrt(a, up=False)
 
 
-def sqrt_up(a: np.ndarray) -> np.ndarray:
+def sqrt_up(a: Floats) -> np.ndarray:
     """Smallest float >= the exact square root of ``a >= 0``."""
     return _sqrt(a, up=True)

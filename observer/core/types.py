@@ -15,7 +15,9 @@ FloatArray = npt.NDArray[np.float64]
 BoolArray = npt.NDArray[np.bool_]
 #: Lower and upper bounds of intervals of the same shape: ``(lo, hi)``.
 Pair = tuple[np.ndarray, np.ndarray]
+#: A float array or a float (what the outward-rounded operations of :mod:`.rounding` accept).
+Floats = np.ndarray | float
 #: A batch of boxes: ``(lo, hi)`` of shape ``(N, n)`` each.
 Batch = tuple[np.ndarray, np.ndarray]
 
-__all__ = ["Batch", "BoolArray", "FloatArray", "Pair"]
+__all__ = ["Batch", "BoolArray", "FloatArray", "Floats", "Pair"]

@@ -114,9 +114,9 @@ def b_min(z: Pair, x: Pair, y: Pair, p: object) -> tuple[Pair, ...]:
     x_must = A.empty_mask(*inter(y, z))  # y cannot be the minimum: x is
     y_must = A.empty_mask(*inter(x, z))
     xz, yz = inter(x, z), inter(y, z)
-    x = tuple(np.where(x_must, a, b) for a, b in zip(xz, x, strict=True))
-    y = tuple(np.where(y_must, a, b) for a, b in zip(yz, y, strict=True))
-    return x, y  # type: ignore[return-value]
+    xn = tuple(np.where(x_must, a, b) for a, b in zip(xz, x, strict=True))
+    yn = tuple(np.where(y_must, a, b) for a, b in zip(yz, y, strict=True))
+    return xn, yn  # type: ignore[return-value]  # numpy stubs: the tuples have two items
 
 
 def b_max(z: Pair, x: Pair, y: Pair, p: object) -> tuple[Pair, ...]:

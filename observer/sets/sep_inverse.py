@@ -48,6 +48,7 @@ class SepInverse(Sep):
         self.centred = bool(centred)
         self.f = f if isinstance(f, Function) else Function(f)
         self.n = self.f.n
+        self.sep_y: Sep | None
         if isinstance(y, Sep):
             if y.n is not None and y.n != self.f.m:
                 raise ValueError(f"y: separator of dimension {y.n}, but f has {self.f.m} outputs")
@@ -76,6 +77,7 @@ class SepInverse(Sep):
         ylo, yhi = image(tape, lo, hi)
         if self.centred:
             ylo, yhi = inter_batch((ylo, yhi), centred_image(self.f, lo, hi))
+        assert self.sep_y is not None  # no box: y is a separator
         yin, yout = self.sep_y.separate(ylo, yhi)
         return hc4(tape, lo, hi, *yin, centred=self.centred), hc4(tape, lo, hi, *yout, centred=self.centred)
 

@@ -273,9 +273,9 @@ def explored_sweep_grid(grid: Grid, pos_lo: Any, pos_hi: Any, psi_lo: Any, psi_h
     key, neg, pos = key[order], neg[order], pos[order]
     run = np.cumsum(np.r_[True, np.diff(key) != 1][: key.size])
     both = (np.bincount(run, neg) > 0) & (np.bincount(run, pos) > 0)
-    clear = np.zeros(grid.n_cells, bool)
-    clear[(key // m)[both[run]]] = True
-    clear = clear.reshape(grid.shape)
+    flat = np.zeros(grid.n_cells, bool)
+    flat[(key // m)[both[run]]] = True
+    clear = flat.reshape(grid.shape)
     st = np.full(grid.shape, UNKNOWN, np.int8)
     st[~seen] = DARK
     st[clear] = CLEAR

@@ -68,7 +68,7 @@ class MissionRecord:
     range: np.ndarray
     no_echo: np.ndarray
     outlier: np.ndarray
-    lateral: np.ndarray | None = None
+    lateral: np.ndarray = None  # type: ignore[assignment]  # None: [0, 0] (set in __post_init__)
 
     def __post_init__(self) -> None:
         d = self.__dict__

@@ -155,9 +155,10 @@ class ThickInverse:
                                   check=False)  # fmt: skip
 
     def _masks(self, lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
-        if self._thr is None:
+        approx = self.f.approx
+        if self._thr is None or approx is None:
             return self._rigorous(lo, hi)
-        a = tuple(v.reshape(lo.shape[0], self.m) for v in self.f.approx(lo, hi)[0])
+        a = tuple(v.reshape(lo.shape[0], self.m) for v in approx(lo, hi)[0])
         fast = self._compare(a, self._thr)
         # rows that the nominal thresholds would decide otherwise lie within the rounding slack: redo
         # them with outward rounding (exact bounds such as ‖x − m‖² = 4 on dyadic boxes are common)

@@ -177,7 +177,7 @@ class Tube:
 
     def first_empty(self) -> int | None:
         """Index of the first empty gate or slice (slice ``k`` ranks with gate ``k``), None if none."""
-        bad = (self.gate_lo > self.gate_hi).any(axis=1)
+        bad = np.asarray((self.gate_lo > self.gate_hi).any(axis=1))
         bad[:-1] |= (self.slice_lo > self.slice_hi).any(axis=1)
         return int(np.argmax(bad)) if bad.any() else None
 
@@ -192,7 +192,7 @@ class Tube:
         if xs.shape[1] != self.n:
             raise ValueError(f"x_samples: expected shape ({ts.size}, {self.n}), got {np.shape(x_samples)}")
         lo, hi = self(ts)
-        return ((lo <= xs) & (xs <= hi)).all(axis=1)
+        return np.asarray(((lo <= xs) & (xs <= hi)).all(axis=1))
 
     def save_npz(self, path: str | Path) -> None:
         """Write the tube to an ``.npz`` file."""
