@@ -199,10 +199,11 @@ def test_every_baseline_runs_a_full_short_episode(env_id: str) -> None:
     env.close()
 
 
-def test_frontier_proves_more_than_random_and_keeps_the_tube_narrow() -> None:
+@pytest.mark.parametrize("dynamics", ["unicycle", "pymunk"])
+def test_frontier_proves_more_than_random_and_keeps_the_tube_narrow(dynamics: str) -> None:
     res = {}
     for name in ("random", "frontier"):
-        env = gym.make("digslam/DigCoverage-v0", max_episode_steps=250)
+        env = gym.make("digslam/DigCoverage-v0", max_episode_steps=250, dynamics=dynamics)
         agent = make_baseline(name, env, seed=0)
         obs, info = env.reset(seed=0)
         for _ in range(250):
@@ -212,7 +213,12 @@ def test_frontier_proves_more_than_random_and_keeps_the_tube_narrow() -> None:
         box = info["pose_box"]
         res[name] = (info["certified_coverage"], float(np.max(box[1] - box[0])), info["bumps"])
     assert res["frontier"][0] > res["random"][0] + 0.15
-    assert res["frontier"][1] < 0.06 and res["frontier"][2] == 0  # straight lines, no bump
+    if dynamics == "unicycle":
+        assert res["frontier"][1] < 0.06 and res["frontier"][2] == 0  # straight lines, no bump
+    else:
+        # with inertia a step's speed hull spans the change of speed within it: the tube grows to about a
+        # metre in 250 steps (issue #23 stays open for a tighter velocity model), yet stays bounded
+        assert res["frontier"][1] < 2.0
 
 
 @pytest.mark.parametrize(

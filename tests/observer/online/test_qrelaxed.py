@@ -204,8 +204,9 @@ def test_q_plus_one_coordinated_bad_readings_can_make_a_false_claim() -> None:
 
 
 # --------------------------------------------------------------------------- the registered env
-def test_digcoverage_outliers_runs_clean_under_the_monitor() -> None:
-    env = gym.make("digslam/DigCoverageOutliers-v0", map_size=36, monitor=True)
+@pytest.mark.parametrize("dynamics", ["unicycle", "pymunk"])
+def test_digcoverage_outliers_runs_clean_under_the_monitor(dynamics: str) -> None:
+    env = gym.make("digslam/DigCoverageOutliers-v0", map_size=36, monitor=True, dynamics=dynamics)
     layer = env
     while not isinstance(layer, GuaranteedObserver):
         layer = layer.env
@@ -221,7 +222,12 @@ def test_digcoverage_outliers_runs_clean_under_the_monitor() -> None:
         assert info["consistent"]
         if term or trunc:
             break
-    assert max(n_out) == 1 and sum(n_out) > 10 and info["certified_coverage"] > 0.02
+    # pymunk's random actions make wide speed hulls (a wider pose box, less proved; issue #23 stays open)
+    assert (
+        max(n_out) == 1
+        and sum(n_out) > 10
+        and info["certified_coverage"] > (0.02 if dynamics == "unicycle" else 0.005)
+    )
     assert_free(layer.filter.dig.free, layer.env.unwrapped.world, layer.grid, rng)
 
 
