@@ -9,7 +9,7 @@ ended (``--target 1.0`` removes that cap). Prints the table (mean ± std of the 
 and 3000 steps, or at ``--steps``), each agent's means, and on the last line
 ``ppo_vs_best_baseline=<PPO mean / best baseline mean at the last reported step>`` (``nan`` without a model).
 
-Usage: ``python benchmarks/bench_agents.py [--maps 20] [--steps 3000] [--seed 1000] [--target T]
+Usage: ``python benchmarks/bench_agents.py [--maps 20] [--steps 3000] [--seed 2000000] [--target T]
 [--model PATH] [--out DIR]``. The env runs at roughly 250 steps/s on one core: the full benchmark (4
 baselines x 20 maps x 3000 steps) takes about half an hour or more; ``--maps 3 --steps 1000`` runs smaller.
 """
@@ -28,6 +28,7 @@ import gymnasium as gym
 import digslam.envs  # noqa: F401  (registers the environments)
 from digslam.agents.baselines.registry import BASELINES, make_baseline
 from digslam.agents.evaluation.evaluate import EvalResult, coverage_figure, evaluate
+from digslam.envs.splits import TEST
 
 ENV_ID = "digslam/DigCoverage-v0"
 MODEL = Path(__file__).resolve().parents[1] / "agents" / "data" / "ppo_digcoverage.zip"
@@ -77,7 +78,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--maps", type=int, default=20, help="held-out maps (default 20)")
     ap.add_argument("--steps", type=int, default=3000, help="steps per episode (default 3000)")
-    ap.add_argument("--seed", type=int, default=1000, help="seed of map 0 (default 1000)")
+    ap.add_argument(
+        "--seed", type=int, default=TEST.start, help=f"seed of map 0 (default {TEST.start}: the test split)"
+    )
     ap.add_argument("--target", type=float, default=None, help="env's termination coverage (default: env's)")
     ap.add_argument("--model", type=Path, default=MODEL, help="PPO model (.zip)")
     ap.add_argument("--out", type=Path, default=None, help="also write coverage.png and evaluation.json here")

@@ -2,9 +2,12 @@
 
 Importing this package registers ``digslam/Explore-v0`` (the thesis room of Fig. 6.10) and its variants
 (:data:`ENV_IDS`), and the certified-coverage ``digslam/DigCoverage-v0`` and its variants
-(:data:`COVERAGE_IDS`: omni-only, sonar-only, large caves, adversarial noise, and unflagged outliers, at most
+(:data:`COVERAGE_IDS`: omni-only, sonar-only, large caves, adversarial noise, 10x odometry noise (stress),
+and unflagged outliers, at most
 one per step, under the observer's q-relaxed mode with ``q = 1``; ``ExploreOutliers-v0`` caps its outliers
-at one per step too). In worker processes that
+at one per step too). Every environment is procedural: the seed passed to ``reset`` picks a new world and a
+new reachable start pose (a level), and :mod:`.splits` fixes the train, validation and test levels
+(``ExploreConfig.map_seed`` pins one world for debugging). In worker processes that
 have not imported it (e.g. SB3's ``SubprocVecEnv`` with forkserver), use the
 ``"digslam.envs:digslam/Explore-v0"`` form, which imports the module first.
 """
@@ -64,6 +67,9 @@ COVERAGE_IDS: dict[str, dict[str, object]] = {
     "digslam/DigCoverageSonar-v0": {"omni": False},
     "digslam/DigCoverageCaves-v0": {"world": "caves", "world_size": 20.0},
     "digslam/DigCoverageAdversarial-v0": {"noise": {"model": "adversarial"}},
+    # the tube matters: odometry 10x noisier than the default, so an agent that never returns to known walls
+    # loses its pose (the impacts on known walls are what narrows the pose box again)
+    "digslam/DigCoverageStress-v0": {"noise": {"speed": 0.01, "yaw_rate": 0.01}},
     "digslam/DigCoverageOutliers-v0": {
         "world": "rocks",
         "noise": {"outlier_prob": 0.05, "max_outliers": 1},

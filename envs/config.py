@@ -27,6 +27,8 @@ NOISE_MODELS = ("uniform", "adversarial", "biased")
 WORLDS = ("room", "rocks", "caves", "rooms", "file")
 #: How the robot moves (:mod:`digslam.envs.sim.robot`): pymunk rigid-body dynamics or exact unicycle arcs.
 DYNAMICS = ("pymunk", "unicycle")
+#: How a reset picks the start pose when ``start`` is None.
+START_RULES = ("reachable", "origin")
 
 
 @config_dataclass
@@ -80,7 +82,13 @@ class ExploreConfig(Config):
         world_size: Half-width of the square frame (m); the frame is ``[-s, s]^2``.
         n_obstacles: Number of rocks (``world='rocks'``).
         map_path: Polygon (``.json``/``.npz``) or image file for ``world="file"``.
-        fixed_world: Keep the world of the first reset (True) or draw a new one at each reset.
+        fixed_world: Keep the world of the first reset until a reset passes a seed (True), or draw a new one
+            at every reset (False, the default: every episode is a new level, Procgen style;
+            ``reset(seed=s)`` always builds the world of level ``s``).
+        room_jitter: Displacement bound (m) of each vertex of the thesis room (``world='room'``), drawn per
+            world: a new room every level (0: the room of Fig. 6.10 exactly).
+        map_seed: When set, every reset uses the world generated from this seed (for debugging one map);
+            the start pose still comes from the reset's seed.
         robot_radius: Robot disc radius (m); the dynamics (:mod:`digslam.envs.sim.robot`) keep this disc off
             every wall. Start poses keep ``1.5 * robot_radius`` plus a skin of ``1.5 * max_speed * dt /
             substeps``, which also pads pymunk's collision disc.
@@ -101,14 +109,20 @@ class ExploreConfig(Config):
         omni_range: Maximum omni range (m).
         noise: Noise configuration (a :class:`NoiseConfig` or a mapping).
         coverage_resolution: Cell size of the ground-truth coverage grid behind the reward (m).
-        start: Start pose ``(x, y, theta)``; None draws a free pose.
+        start: Start pose ``(x, y, theta)``; None draws one from the reset's seed, uniformly in the reachable
+            free space (:meth:`~digslam.envs.sim.world.World.sample_reachable_pose`: the largest region
+            where the robot keeps its start clearance, so no start lies in a pocket), heading uniform.
+        start_rule: ``reachable`` (above) or ``origin``: the origin with a uniform heading when it is free
+            enough, else any free pose (the rule before procedural maps; older episode files replay with it).
     """
 
     world: str = "room"
     world_size: float = 10.0
     n_obstacles: int = 30
     map_path: str | None = None
-    fixed_world: bool = True
+    fixed_world: bool = False
+    room_jitter: float = 0.3
+    map_seed: int | None = None
     robot_radius: float = 0.2
     max_speed: float = 1.0
     max_yaw_rate: float = 1.0
@@ -125,6 +139,7 @@ class ExploreConfig(Config):
     noise: NoiseConfig = field(default_factory=NoiseConfig)
     coverage_resolution: float = 0.1
     start: tuple[float, float, float] | None = None
+    start_rule: str = "reachable"
 
     def __post_init__(self) -> None:
         if isinstance(self.noise, Mapping):
@@ -132,6 +147,7 @@ class ExploreConfig(Config):
         check(isinstance(self.noise, NoiseConfig), "noise", "must be a NoiseConfig or a mapping")
         check_choice("world", self.world, WORLDS)
         check_choice("dynamics", self.dynamics, DYNAMICS)
+        check_choice("start_rule", self.start_rule, START_RULES)
         check(self.world != "file" or bool(self.map_path), "map_path", "is required when world='file'")
         for name in (
             "world_size",
@@ -155,6 +171,17 @@ class ExploreConfig(Config):
             "sonar_gamma",
             f"aperture must be in (0, pi], got {self.sonar_gamma!r}",
         )
+        check(
+            math.isfinite(self.room_jitter) and 0.0 <= self.room_jitter <= 0.1 * self.world_size,
+            "room_jitter",
+            f"must be in [0, world_size / 10], got {self.room_jitter!r}",
+        )
+        if self.map_seed is not None:
+            check(
+                isinstance(self.map_seed, int) and not isinstance(self.map_seed, bool) and self.map_seed >= 0,
+                "map_seed",
+                f"must be a non-negative integer or None, got {self.map_seed!r}",
+            )
         if self.start is not None:
             check(
                 len(self.start) == 3 and all(math.isfinite(float(s)) for s in self.start),
@@ -168,5 +195,6 @@ __all__ = [
     "ExploreConfig",
     "NOISE_MODELS",
     "NoiseConfig",
+    "START_RULES",
     "WORLDS",
 ]

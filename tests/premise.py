@@ -28,8 +28,9 @@ the truth without the simulator's code and checks that premise step by step:
   body-frame velocity ``R(-psi) u_j``, ``u_j = (p_{j+1} - p_j) / tau_j`` (``Fraction``), inside
   ``record.speed x record.lateral`` for every heading ``psi`` between ``a_j`` and ``a_{j+1}``: the extremes
   of each component over that range lie at its ends or where ``psi - atan2(u_y, u_x)`` is a multiple of
-  ``pi/2`` (:func:`velocity_extremes`, mpmath). A unicycle step (``truth.pieces``) has no lateral velocity:
-  ``record.lateral`` must contain 0.
+  ``pi/2`` (:func:`velocity_extremes`, mpmath). The odometry increment ``record.mean_velocity`` must contain
+  ``R(-a_0) (p_S - p_0) / dt`` (:func:`mean_velocity_exact`, mpmath). A unicycle step (``truth.pieces``) has
+  no lateral velocity: ``record.lateral`` must contain 0; its ``mean_velocity`` must be unmeasured.
 * **The disc** (when ``radius`` is given, pymunk steps): the robot's disc of that radius centred anywhere on
   a substep segment keeps off every edge: the exact (``Fraction``) distance between the segment and each
   edge is at least ``radius`` (:func:`segment_distance2`; edges farther than ``radius + 0.01`` in floats
@@ -98,6 +99,23 @@ class ExactPose:
     def floats(self) -> np.ndarray:
         """Nearest float64 ``(x, y, th)``."""
         return np.array([float(self.x), float(self.y), self.th])
+
+
+def mean_velocity_exact(states: np.ndarray, taus: np.ndarray) -> tuple[Any, Any]:
+    """The odometry increment of a pymunk path, in mpmath: ``R(-a_0) (p_S - p_0) / dt``, ``dt = sum(taus)``
+    (exact), i.e. ``(1/dt) ∫ R(psi(t) - a_0) v(t) dt`` along the piecewise-linear path."""
+    dt = sum(Fraction(float(t)) for t in taus)
+    return increment(mpf(states[0, 0]), mpf(states[0, 1]), float(states[0, 2]), mpf(states[-1, 0]),
+                     mpf(states[-1, 1]), dt)  # fmt: skip
+
+
+def increment(x0: Any, y0: Any, th0: float, x1: Any, y1: Any, dt: Fraction) -> tuple[Any, Any]:
+    """``R(-th0) (p_1 - p_0) / dt`` in mpmath (forward, leftward)."""
+    with mpmath.workprec(PREC):
+        t = mpmath.mpf(dt.numerator) / dt.denominator
+        c, s = mpmath.cos(mpf(th0)), mpmath.sin(mpf(th0))
+        dx, dy = x1 - x0, y1 - y0
+        return (c * dx + s * dy) / t, (c * dy - s * dx) / t
 
 
 def velocity_extremes(ux: Fraction, uy: Fraction, a0: float, a1: float) -> tuple[Any, Any, Any, Any]:
@@ -346,6 +364,7 @@ class PremiseChecker:
                     self.fail(f"a piece of zero duration turns the heading {th!r} -> {th1!r}")
                 x, y = arc_exact(x, y, th, v, tau, th1)
                 th = th1
+        self._check_mean(record, self.pose, ExactPose(x, y, th), Fraction(t) - Fraction(self.t))
         self.pose = ExactPose(x, y, th)
         self.t = t
         self._common(record, truth)
@@ -375,9 +394,23 @@ class PremiseChecker:
                 f"substep durations {taus.tolist()} do not sum exactly to t_k - t_(k-1) = {float(dt)!r}"
             )
         self.check_path(states, taus, record)
+        end = ExactPose(mpf(states[-1, 0]), mpf(states[-1, 1]), float(states[-1, 2]))
+        self._check_mean(record, start, end, dt)
         self.paths.append((states, taus))
         self.pose = ExactPose(mpf(states[-1, 0]), mpf(states[-1, 1]), float(states[-1, 2]))
         self.t = t
+
+    def _check_mean(self, record: Any, start: ExactPose, end: ExactPose, dt: Fraction) -> None:
+        """The odometry increment ``record.mean_velocity`` (when present) contains ``R(-th_0) (p_1 - p_0)
+        / dt`` between the exact poses."""
+        mean = getattr(record, "mean_velocity", None)
+        if mean is None:
+            return
+        exact = increment(start.x, start.y, start.th, end.x, end.y, dt)
+        for name, m, iv in zip(("forward", "leftward"), exact, np.asarray(mean), strict=True):
+            if not _within(m, iv):
+                self.fail(f"mean_velocity ({name}) interval {iv.tolist()} misses the exact odometry increment "
+                          f"{mpmath.nstr(m, 17)}")  # fmt: skip
 
     def check_path(self, states: np.ndarray, taus: np.ndarray, record: Any = None) -> None:
         """Check each substep of a pymunk path in exact arithmetic: its yaw rate and body-frame velocity

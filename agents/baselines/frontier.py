@@ -310,31 +310,57 @@ class UncertaintyAwareFrontier(FrontierAgent):
             x["closures"] = x.get("closures", 0) + 1
             mem.goal = mem.waypoint = None
         if x.get("closing") is not None:
-            shrunk = view.tube <= self.shrink * x["closing"]
             over = mem.t - x["t0"] > self.closure_steps or len(x["done_at"]) >= self.visits
-            if shrunk or over:
-                if not shrunk:
-                    x["high"] = max(high, view.tube) * self.backoff
-                x["closing"] = None
-                mem.goal = mem.waypoint = None
+            if view.tube <= self.shrink * x["closing"] or over:
+                self._end_closure(view, mem)
+                mem.goal = mem.waypoint = None  # the goal was a loop-closure target
         return super()._act(view, mem)
+
+    def _end_closure(self, view: View, mem: Memory) -> None:
+        """Leave the loop-closure mode; a closure that did not shrink the tube raises the threshold."""
+        x = mem.extra
+        if view.tube > self.shrink * x["closing"]:
+            x["high"] = max(x["high"], view.tube) * self.backoff
+        x["closing"] = None
+
+    def _plan(self, view: View, mem: Memory) -> None:
+        """Plan as :class:`NavigatingAgent`; a closure with no target left in the last planning pass (no
+        remembered narrow-tube obstacle pixel reachable, even across penumbra) ends at once, as a failed
+        one unless the tube already shrank, and the goal just chosen (a frontier goal) is kept."""
+        x = mem.extra
+        x["targets"] = False
+        super()._plan(view, mem)
+        if x.get("closing") is not None and not x["targets"]:
+            self._end_closure(view, mem)
+            x["exhausted"] = x.get("exhausted", 0) + 1  # closures that ran out of targets (diagnostics)
 
     def _goal_reached(self, view: View, mem: Memory) -> None:
         if mem.extra.get("closing") is not None:
             mem.extra["done_at"].append(view.pos.copy())
 
+    def closure_targets(self, view: View, mem: Memory, reach: np.ndarray) -> np.ndarray:
+        """``(m, m)`` bool: the reachable pixels next to sensed obstacles passed with a tube at most half as
+        wide as at the switch, at least ``spread`` m from the visits done in this closure."""
+        m = view.clear.shape[0]
+        near = (
+            reach
+            & pl.dilate(view.penumbra, self.erosion(view) + 1)
+            & (mem.best_tube <= 0.5 * mem.extra["closing"])
+        )
+        for p in mem.extra["done_at"]:
+            near &= ~self._disk(m, p, self.spread / self.px(m))
+        return near
+
     def _costs(self, view: View, mem: Memory, reach: np.ndarray, dist: np.ndarray) -> np.ndarray:
+        """Path lengths to the closure targets while closing a loop; frontier costs otherwise, and when no
+        target is reachable in this pass (``_plan`` then ends the closure, unless the cautious pass over
+        penumbra reaches one)."""
         x = mem.extra
         if x.get("closing") is None:
             return self.frontier_costs(view, mem, reach, dist)
-        m = view.clear.shape[0]
-        near = (
-            reach & pl.dilate(view.penumbra, self.erosion(view) + 1) & (mem.best_tube <= 0.5 * x["closing"])
-        )
-        for p in x["done_at"]:
-            near &= ~self._disk(m, p, self.spread / self.px(m))
-        if not near.any():
-            x["done_at"] = [None] * self.visits  # nowhere to go: the closure ends
+        near = self.closure_targets(view, mem, reach)
+        x["targets"] = bool(near.any())
+        if not x["targets"]:
             return self.frontier_costs(view, mem, reach, dist)
         return np.where(near, dist, np.inf)
 

@@ -5,8 +5,9 @@ world regenerated at each reset, ``fixed_world=False``) and records, after each 
 (the guaranteed observer's claim, ``info["certified_coverage"]``) and the ground-truth coverage
 (``info["true_coverage"]``), both shares of the same area, the reachable free area (free cells connected to
 the start, :func:`digslam.envs.dig_coverage.wrapper.reachable_free`), so certified <= ground truth; padded
-with the last value once the episode ends; plus the collisions (``info["bumps"]``) and the final tube
-width (widest side of the pose box, m). Policies are objects with
+with the last value once the episode ends; plus the collisions (``info["bumps"]``), the final tube
+width (widest side of the pose box, m) and the true path length (m). :meth:`EvalResult.metrics` turns them
+into the benchmark metrics of :mod:`.metrics` (T80 / T90 / T95, AUC, ...). Policies are objects with
 ``predict(obs, state=None, episode_start=None, deterministic=True)``: the baselines of :mod:`.baselines` or
 stable-baselines3 models.
 
@@ -27,6 +28,8 @@ from typing import Any
 
 import numpy as np
 
+from digslam.agents.evaluation.metrics import episodes_metrics, path_length
+
 #: Environment keyword arguments that :func:`evaluate` sets unless ``env_kwargs`` does.
 EVAL_DEFAULTS: dict[str, Any] = {"fixed_world": False}
 
@@ -43,6 +46,7 @@ class EvalResult:
             observer found the data inconsistent).
         lengths: agent -> ``(n_episodes,)`` steps actually run (termination or truncation ends earlier).
         env_id, seed, n_maps: what was evaluated.
+        path_lengths: agent -> ``(n_episodes,)`` metres the true robot travelled (empty when not measured).
     """
 
     curves: dict[str, np.ndarray]
@@ -53,6 +57,7 @@ class EvalResult:
     env_id: str = ""
     seed: int = 0
     n_maps: int = 0
+    path_lengths: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def n_steps(self) -> int:
@@ -63,6 +68,17 @@ class EvalResult:
         """agent -> ``(n_episodes,)`` coverage after ``step`` steps (clamped to the curves' length)."""
         src = self.true_curves if truth else self.curves
         return {a: c[:, min(max(int(step), 0), c.shape[1] - 1)] for a, c in src.items()}
+
+    def metrics(self) -> dict[str, dict[str, np.ndarray]]:
+        """agent -> metric -> ``(n_episodes,)``: :func:`.metrics.episodes_metrics` of the certified curves,
+        the step budget being the curves' steps (an unmeasured path length is nan)."""
+        out = {}
+        for a, c in self.curves.items():
+            extra = {"collisions": self.collisions[a], "final_tube": self.final_tube_width[a]}
+            if a in self.path_lengths:
+                extra["path"] = self.path_lengths[a]
+            out[a] = episodes_metrics(c, c.shape[1] - 1, **extra)
+        return out
 
     def table(self, at: Sequence[int] = (1000, 3000)) -> str:
         """Markdown table, mean ± std over episodes: certified coverage at each step of ``at`` that the
@@ -101,6 +117,7 @@ class EvalResult:
             "env_id": self.env_id,
             "seed": self.seed,
             "n_maps": self.n_maps,
+            "path_lengths": enc(self.path_lengths),
         }
         p = Path(path)
         p.parent.mkdir(parents=True, exist_ok=True)
@@ -126,6 +143,7 @@ class EvalResult:
                 env_id=str(data.get("env_id", "")),
                 seed=int(data.get("seed", 0)),
                 n_maps=int(data.get("n_maps", 0)),
+                path_lengths=dec(data.get("path_lengths", {})),
             )
         except KeyError as exc:
             raise ValueError(f"path: {path} is not an EvalResult JSON (missing {exc})") from None
@@ -144,13 +162,15 @@ def make_env(env_id: str, steps: int, env_kwargs: dict[str, Any] | None, render:
 
 def run_episode(
     policy: Any, env: Any, seed: int, steps: int
-) -> tuple[np.ndarray, np.ndarray, int, float, int]:
-    """One episode: certified and true coverage after each step (padded), bumps, final tube width, length."""
+) -> tuple[np.ndarray, np.ndarray, int, float, int, float]:
+    """One episode: certified and true coverage after each step (padded), bumps, final tube width, length,
+    true path length (m)."""
     if hasattr(policy, "reset") and callable(policy.reset) and not hasattr(policy, "policy"):
         policy.reset()  # a baseline (an SB3 model has .policy and no per-episode state)
     obs, info = env.reset(seed=seed)
     cert, true = np.empty(steps + 1), np.empty(steps + 1)
     cert[0], true[0] = info["certified_coverage"], info["true_coverage"]
+    positions = [np.asarray(info["truth"].pose[:2], dtype=np.float64)]
     state, start, n = None, np.ones(1, dtype=bool), 0
     for n in range(1, steps + 1):
         action, state = policy.predict(obs, state=state, episode_start=start, deterministic=True)
@@ -158,12 +178,13 @@ def run_episode(
         action = np.clip(np.asarray(action, dtype=np.float32).reshape(env.action_space.shape), -1.0, 1.0)
         obs, _, terminated, truncated, info = env.step(action)
         cert[n], true[n] = info["certified_coverage"], info["true_coverage"]
+        positions.append(np.asarray(info["truth"].pose[:2], dtype=np.float64))
         if terminated or truncated:
             cert[n + 1 :], true[n + 1 :] = cert[n], true[n]
             break
     box = np.asarray(info.get("pose_box", np.full((2, 2), np.nan)), dtype=np.float64)
     tube = float(np.max(box[1] - box[0])) if np.all(np.isfinite(box)) else math.nan
-    return cert, true, int(info.get("bumps", 0)), tube, n
+    return cert, true, int(info.get("bumps", 0)), tube, n, path_length(np.array(positions))
 
 
 def evaluate(
@@ -195,7 +216,7 @@ def evaluate(
         from tqdm.auto import tqdm
 
         bar = tqdm(total=len(policies) * n_maps, desc="evaluate", unit="episode")
-    out: dict[str, dict[str, np.ndarray]] = {k: {} for k in ("c", "t", "b", "w", "n")}
+    out: dict[str, dict[str, np.ndarray]] = {k: {} for k in "ctbwnp"}
     for name, policy in policies.items():
         env = make_env(env_id, steps, env_kwargs)
         try:
@@ -207,11 +228,11 @@ def evaluate(
                     bar.update()
         finally:
             env.close()
-        for key, j in zip("ctbwn", range(5), strict=True):
+        for key, j in zip("ctbwnp", range(6), strict=True):
             out[key][name] = np.array([r[j] for r in rows], dtype=np.float64)
     if bar is not None:
         bar.close()
-    return EvalResult(out["c"], out["t"], out["b"], out["w"], out["n"], env_id, seed, n_maps)
+    return EvalResult(out["c"], out["t"], out["b"], out["w"], out["n"], env_id, seed, n_maps, out["p"])
 
 
 def coverage_figure(result: EvalResult, path: str | Path, target: float | None = None) -> Path:

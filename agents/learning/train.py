@@ -10,8 +10,8 @@ TensorBoard logs, checkpoints, evaluation on held-out map seeds and a progress b
 ``torch_threads`` threads in every process (one thread is several times faster on small machines).
 
 >>> cfg = TrainConfig().override(["n_envs=1", "env_kwargs.map_size=40"])
->>> cfg.n_envs, cfg.env_kwargs["map_size"], cfg.eval_seeds()[:2]
-(1, 40, (500, 501))
+>>> cfg.n_envs, cfg.env_kwargs["map_size"], cfg.eval_seeds()[:2]  # validation levels (digslam.envs.splits)
+(1, 40, (1000000, 1000001))
 >>> TrainConfig.from_dict({"n_env": 2})  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
@@ -32,6 +32,7 @@ from typing import Any
 
 import gymnasium as gym
 
+from digslam.envs.splits import VALIDATION, check_not_test
 from digslam.observer.core.config import Config, config_dataclass
 
 try:
@@ -62,7 +63,8 @@ class TrainConfig(Config):
         features_dim: Output size of the features extractor.
         eval_freq: Timesteps between evaluations on the held-out maps (0: none).
         eval_maps: Number of held-out maps (seeds ``eval_seed, eval_seed + 1, ...``).
-        eval_seed: First held-out seed; the held-out seeds must not meet the training seeds.
+        eval_seed: First held-out seed (default: the validation split's first, :mod:`digslam.envs.splits`);
+            the held-out seeds must not meet the training seeds, and neither may lie in the test split.
         checkpoint_freq: Timesteps between checkpoints (0: none).
         out_dir: Folder for the model, checkpoints, TensorBoard logs and evaluations.
         device: Torch device (``"cpu"``).
@@ -85,7 +87,7 @@ class TrainConfig(Config):
     features_dim: int = 128
     eval_freq: int = 40_960
     eval_maps: int = 3
-    eval_seed: int = 500
+    eval_seed: int = VALIDATION.start
     checkpoint_freq: int = 10_240
     out_dir: str = "runs/ppo_digcoverage"
     device: str = "cpu"
@@ -117,6 +119,8 @@ class TrainConfig(Config):
             raise ValueError(
                 f"eval_seed: held-out seeds {self.eval_seeds()} meet the training seeds {self.train_seeds()}"
             )
+        check_not_test("seed", self.train_seeds())  # the benchmark's levels stay unseen
+        check_not_test("eval_seed", self.eval_seeds())
 
     def train_seeds(self) -> tuple[int, ...]:
         """Seeds of the training environments."""

@@ -15,6 +15,13 @@ certified count in one pass, and :func:`sets_and_map` keeps them and the image u
 of cells a step changed; :func:`observe` does that, then the pose-box channel, the ``"state"`` vector and
 the copies ``info`` hands out, all in one compiled call per step (the wrapper's fast path).
 
+**The observation holds no ground truth.** The image and the state are drawn from the filter's sets, the
+pose and heading boxes, the grid and the step count only. The ``reach`` plane (the true reachable free
+cells) feeds nothing but the count these kernels return, which the wrapper puts in ``info`` and the reward;
+the state's certified value is the share of the *grid's* cells that are clear, not of the reachable ones
+(the grid is the observer's own, fixed by its configuration; the reachable area is what a real robot does
+not know, and a share of it would tell the agent how much is left to find).
+
 >>> clear = np.zeros((4, 4), bool); clear[:2, :2] = True; clear[0, 2] = True
 >>> dark = np.zeros((4, 4), bool); dark[2:, 2:] = True
 >>> c, p, d = three_state(clear, dark, 2)
@@ -70,7 +77,8 @@ class MapPlanes(NamedTuple):
         explored: the explored codes (int8 ``CLEAR``, ``PENUMBRA``, ``DARK``, or their uint8 bytes).
         clear: the clear mask (certainly sensed and proved free; bool or uint8 0 / 1).
         dark: the dark mask (certainly not sensed).
-        reach: the reachable free cells (the certified count is taken over them).
+        reach: the reachable free cells, ground truth: only the count returned to the wrapper (``info``,
+            reward) is taken over them, never the observation.
     """
 
     explored: np.ndarray
@@ -93,7 +101,6 @@ class MapContext(NamedTuple):
         xs, nys: the grid's exact cell bounds (``nys = -ys``), for the pose-box channel; the state is
             normalised over the grid's frame ``[xs[0], xs[-1]] × [-nys[-1], -nys[0]]``.
         horizon: the episode's step horizon (the state's elapsed-steps value is ``steps / horizon``).
-        n_reach: the number of reachable free cells (the certified fraction's denominator).
     """
 
     sure: np.ndarray
@@ -111,7 +118,6 @@ class MapContext(NamedTuple):
     xs: np.ndarray
     nys: np.ndarray
     horizon: float
-    n_reach: int
 
 
 @njit
@@ -234,13 +240,14 @@ def observe(maps: MapContext, pose_lo: np.ndarray, pose_hi: np.ndarray, heading:
     ``win`` of cells the step changed into the planes and ``base`` of ``maps`` (the clear / penumbra / dark
     channels), then ``img[:3] = base``, ``img[3]`` the pose-box footprint (the pixels whose blocks meet the
     cells of the position box ``pose_lo``, ``pose_hi``, :func:`~digslam.observer.core.grid_jit.window`)
-    and the 11 values of ``state`` (the wrapper's ``"state"``, with the heading interval ``heading``);
+    and the 11 values of ``state`` (the wrapper's ``"state"``, with the heading interval ``heading``; its
+    ``state[9]`` is the share of the grid's cells that are clear, from the observer alone);
     ``snap`` ``(3, ny, nx)`` uint8 receives copies of the explored codes, the clear mask and ``maps.free``.
 
-    ``steps`` is the number of elapsed steps and ``n_prev`` the certified count before the step; returns
-    the new count. No argument checks: the wrapper's own arrays (:class:`MapContext`). Only ``maps`` is a
-    named tuple: each one costs about a microsecond at every call from Python, and this call runs at every
-    step.
+    ``steps`` is the number of elapsed steps and ``n_prev`` the certified count before the step (clear cells
+    in ``maps.reach``, ground truth); returns the new count, which enters neither ``img`` nor ``state``. No
+    argument checks: the wrapper's own arrays (:class:`MapContext`). Only ``maps`` is a named tuple: each one
+    costs about a microsecond at every call from Python, and this call runs at every step.
     """
     sure, free = maps.sure, maps.free
     ny, nx = sure.shape
@@ -258,8 +265,10 @@ def observe(maps: MapContext, pose_lo: np.ndarray, pose_hi: np.ndarray, heading:
     k = e8.size
     for i in range(k):  # the snapshot: explored, clear, free
         s8[i] = e8[i]
+    n_clear = 0  # every clear cell of the grid: the state's certified share (no ground truth)
     for i in range(k):
         s8[k + i] = c8[i]
+        n_clear += np.int64(c8[i])
     for i in range(k):
         s8[2 * k + i] = f8[i]
     b8, o8 = base.reshape(-1), img.reshape(-1)  # flat loops (C-contiguous): they vectorize
@@ -290,19 +299,18 @@ def observe(maps: MapContext, pose_lo: np.ndarray, pose_hi: np.ndarray, heading:
     state[6] = min(hw / math.pi, 1.0)
     state[7] = math.tanh(max(x1 - x0, y1 - y0))
     state[8] = min(steps / maps.horizon, 1.0)
-    state[9] = n / maps.n_reach
+    state[9] = n_clear / ny / nx
     state[10] = 1.0
     return n
 
 
 def map_context(sets: tuple[np.ndarray, np.ndarray, np.ndarray], planes: MapPlanes, base: np.ndarray,
-                xs: np.ndarray, nys: np.ndarray, horizon: float, n_reach: int) -> MapContext:  # fmt: skip
+                xs: np.ndarray, nys: np.ndarray, horizon: float) -> MapContext:  # fmt: skip
     """The :class:`MapContext` of :func:`observe`: the filter's ``sets = (sure, maybe, free)``, the caller's
     ``planes`` and ``base`` (kept), the pixel blocks of ``base.shape[-1]`` pixels a side, the grid's cell
-    bounds ``xs``, ``nys = -ys`` (its frame's ends first and last), the ``horizon`` and ``n_reach`` (the
-    reachable free cells, at least 1)."""
+    bounds ``xs``, ``nys = -ys`` (its frame's ends first and last) and the ``horizon``."""
     blocks = pixel_blocks(planes.clear.shape, base.shape[-1])
-    return MapContext(*sets, *planes, base, *blocks, xs, nys, float(horizon), int(n_reach))
+    return MapContext(*sets, *planes, base, *blocks, xs, nys, float(horizon))
 
 
 @lru_cache(maxsize=64)

@@ -10,7 +10,17 @@ pose box, the dig zone ``M⁻`` and the explored thick set, and the wrapper hand
   box (world-aligned; outside the grid counts as dark);
 * ``"state"``: ``float32 (11,)``: the pose box ``(x⁻, y⁻, x⁺, y⁺)`` normalised to ``[-1, 1]`` over the grid
   frame, ``cos``/``sin`` of the mid heading and the heading half-width over ``π``, ``tanh`` of the tube width
-  (m), the elapsed share of ``horizon``, the certified coverage and the consistency flag.
+  (m), the elapsed share of ``horizon``, the certified share of the grid (clear cells over all the grid's
+  cells: the clear area in m² over the grid's area) and the consistency flag.
+
+**Observations from the observer only.** Everything in ``"map"`` and ``"state"`` comes from the filter's
+sets and boxes, the grid and the step count: two worlds that give the same records (and the same start
+box) give the same observations. Ground truth (the true reachable free area, ``truth``) enters only the
+reward, the termination and ``info``. So ``state[9]`` is *not* ``info["certified_coverage"]``: that one is
+a share of the reachable free area, which a real robot does not know and which would tell the agent how
+much is left to find; the state's value grows with the same clear area but over a denominator fixed in
+advance. (It used to be the reachable share, issue #18: the shipped PPO model was trained with that one;
+it still loads and runs, its behaviour may shift.)
 
 ``info`` adds the sets as arrays (``explored`` int8 CLEAR/PENUMBRA/DARK, ``dig`` and ``clear`` bool, all
 ``(ny, nx)`` with row 0 at the top; ``pose_box (2, 2)``, ``heading_box (2,)``), ``certified_coverage``
@@ -185,7 +195,8 @@ class GuaranteedObserver(gym.Wrapper):
         self._cache: tuple[np.ndarray, np.ndarray, np.ndarray, int] = (np.zeros(0),) * 3 + (0,)
         self._dig_copy = np.zeros(0, bool)
         m, shape = cfg.map_size, g.shape
-        self._planes = np.zeros((4, *shape), np.uint8)  # explored (int8), clear, dark, reachable: observe()
+        # explored (int8), clear, dark, reachable (ground truth: only for the count of info and the reward)
+        self._planes = np.zeros((4, *shape), np.uint8)
         self._explored_all, self._clear_all = self._planes[0].view(np.int8), self._planes[1].view(np.bool_)
         self._dark_all, self._base, self._n = self._planes[2].view(np.bool_), np.zeros((3, m, m), np.uint8), 0
         self._xs, self._nys = np.array(g.xs, np.float64), np.array(-g.ys, np.float64)
@@ -210,7 +221,7 @@ class GuaranteedObserver(gym.Wrapper):
         f = self.filter
         sets = (f.sensed_sure, f.sensed_maybe, f.dig.free)
         self._maps = map_context(sets, MapPlanes(*self._planes), self._base, self._xs, self._nys,
-                                 self.obs_config.horizon, self.n_reachable)  # fmt: skip
+                                 self.obs_config.horizon)  # fmt: skip
         self.steps, self._cache_step = 0, -1
         # ground truth over the cells of the certified coverage, the reachable free area (:mod:`.coverage`)
         self.truth_coverage = Coverage.on_cells(self.reachable[::-1], self.grid.lo, self.grid.cell_size,

@@ -12,12 +12,12 @@ from .coverage import (
     Coverage,
 )
 from .coverage_jit import (
+    BLOCK,
     NB,
-    ConeReach,
-    CoverGrid,
-    cover_kernel,
-    cover_update,
+    cone_table,
+    cover_step,
     pseudo_angle,
+    todo_blocks,
 )
 from .env import (
     ExploreEnv,
@@ -32,16 +32,16 @@ from .truth import (
 )
 
 __all__ = [
-    "ConeReach",
-    "CoverGrid",
+    "BLOCK",
     "Coverage",
     "Episode",
     "ExploreEnv",
     "GroundTruth",
     "NB",
-    "cover_kernel",
-    "cover_update",
+    "cone_table",
+    "cover_step",
     "pseudo_angle",
     "record_episode",
     "replay",
+    "todo_blocks",
 ]

@@ -3,7 +3,7 @@
 A cell counts once its centre has lain inside some sensor's sector closer than the true range (or ``r_max``
 without echo): such points are certainly free. Only the cells of a given set of free cells count, so the
 covered area never includes obstacle area. Each update is one compiled pass over the cells within reach
-(:func:`.coverage_jit.cover_update`).
+that are still to cover (:func:`.coverage_jit.cover_step`: blocks of cells already covered are skipped).
 
 Two areas are in use, and each figure says which:
 
@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from digslam.envs.explore.coverage_jit import cover_update
+from digslam.envs.explore.coverage_jit import cone_table, cover_step, todo_blocks
 from digslam.envs.sim.raster import FREE
 from digslam.envs.sim.sensors import SensorSuite
 from digslam.envs.sim.world import World
@@ -70,7 +70,11 @@ class Coverage:
         self.xs = self.x0 + (np.arange(nx) + 0.5) * self.resx
         self.ys = self.y0 + (np.arange(ny) + 0.5) * self.resy
         self._win = np.array([self.x0, self.y0, self.resx, self.resy, self.kx, self.ky], dtype=np.float64)
+        self._geo = np.concatenate([self._win, self.xs, self.ys])  # what cover_step reads of the grid
+        self._todo = self.free.copy()  # free and not yet seen: update() keeps it with seen
+        self._blocks = todo_blocks(self._todo)
         self._cell_area = self.resx * self.resy
+        self._cones_for: SensorSuite | None = None
 
     def _angular_cover(self, suite: SensorSuite) -> tuple[np.ndarray, np.ndarray]:
         """Cone-edge bearings in ``[0, 2 pi)`` (sorted, from 0) and which sensors cover each interval."""
@@ -94,17 +98,18 @@ class Coverage:
         return float(self.n_seen) / max(self.total_free, 1)
 
     def update(self, pose: np.ndarray, suite: SensorSuite, ranges: np.ndarray) -> float:
-        """Mark the cells sensed from ``pose`` and return the newly covered area (m^2)."""
+        """Mark the cells sensed from ``pose`` and return the newly covered area (m^2).
+
+        The only writer of :attr:`seen`: it keeps the cells still to cover beside it."""
         p, rng = pose, ranges
         if not (type(p) is np.ndarray and p.dtype == np.float64 and p.shape == (3,)):
             p = np.array([float(pose[0]), float(pose[1]), float(pose[2])])
         if not (type(rng) is np.ndarray and rng.dtype == np.float64 and rng.flags.c_contiguous):
             rng = np.ascontiguousarray(ranges, dtype=np.float64)
-        if getattr(self, "_cover_for", None) is not suite:
-            self._angular_cover(suite)
-        breaks, cover = self._cover
-        hits = cover_update(self.free, self.seen, self.xs, self.ys, self._win, p, breaks, cover, rng,
-                            suite._k_r_max)  # fmt: skip
+        if self._cones_for is not suite:
+            self._cones = cone_table(*self._angular_cover(suite), suite.r_max)
+            self._cones_for = suite
+        hits = cover_step(self._todo, self._blocks, self.seen, self._geo, p, self._cones, rng)
         self.n_seen += hits
         return hits * self._cell_area
 

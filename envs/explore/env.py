@@ -15,7 +15,10 @@ Record convention (record ``j`` is the one returned at time ``t_j``; ``j = 0`` b
 * ``speed[j]``, ``lateral[j]`` and ``yaw_rate[j]`` bound the true body-frame velocity ``(v_1, v_2)`` and yaw
   rate over the WHOLE step that just ended, ``[t_{j-1}, t_j]`` (the hull over all its physics substeps, see
   :mod:`digslam.envs.sim.robot`), not instantaneous values; record 0 carries the robot at rest, ``[0, 0]``
-  widened by the noise bound. The unicycle cannot slip: its ``lateral`` is ``[0, 0]``, exactly.
+  widened by the noise bound. The unicycle cannot slip: its ``lateral`` is ``[0, 0]``, exactly;
+* ``mean_velocity[j]`` (pymunk) bounds the odometry increment of that step, the velocity averaged over it in
+  the body frame at ``t_{j-1}``: ``R(-psi_{j-1}) (x_j - x_{j-1}) / (t_j - t_{j-1})``, tight when the
+  velocity changes within the step; the unicycle leaves it unmeasured (``[-inf, inf]``).
 
 This is the data contract of :mod:`digslam.observer.slam.record`, which the observers (offline ``dig_slam``,
 the online filter of :mod:`.observer_wrapper`) read as it is. Every bound contains the exact truth,
@@ -47,7 +50,7 @@ from digslam.envs.sim.arc_jit import exact_duration
 from digslam.envs.sim.generators import GENERATORS, WorldGenerator
 from digslam.envs.sim.noise_jit import obs_kernel
 from digslam.envs.sim.robot import RobotSim
-from digslam.envs.sim.sensors import SensorSuite, measure_step
+from digslam.envs.sim.sensors import SensorSuite, record_step
 from digslam.envs.sim.world import World
 from digslam.observer.slam.record import MissionRecord
 
@@ -57,6 +60,8 @@ def _generator(cfg: ExploreConfig) -> WorldGenerator:
         return GENERATORS["file"](cfg.map_path, size=cfg.world_size)  # type: ignore[call-arg]
     if cfg.world == "rocks":
         return GENERATORS["rocks"](size=cfg.world_size, n=cfg.n_obstacles)  # type: ignore[call-arg]
+    if cfg.world == "room":
+        return GENERATORS["room"](size=cfg.world_size, jitter=cfg.room_jitter)  # type: ignore[call-arg]
     return GENERATORS[cfg.world](size=cfg.world_size)
 
 
@@ -112,6 +117,7 @@ class ExploreEnv(gym.Env):
         hb = self.observation_space["heading"]
         self._heading_box = (float(hb.low[0]), float(hb.high[0]))
         self.world: World | None = None
+        self._world_seed: int | None = None
         self.sim: RobotSim | None = None
         self.coverage: Coverage | None = None
         self._renderer: Any = None
@@ -125,17 +131,24 @@ class ExploreEnv(gym.Env):
     ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         super().reset(seed=seed)
         cfg = self.config
-        if seed is not None or self.world is None or not cfg.fixed_world:
-            self.world = self.generator.generate(int(self.np_random.integers(2**31 - 1)))
-        heading = float(self.np_random.uniform(-math.pi, math.pi))
+        if cfg.map_seed is not None:  # one map for debugging
+            if self.world is None or self._world_seed != cfg.map_seed:
+                self.world, self._world_seed = self.generator.generate(cfg.map_seed), cfg.map_seed
+        elif seed is not None or self.world is None or not cfg.fixed_world:
+            self._world_seed = int(self.np_random.integers(2**31 - 1))
+            self.world = self.generator.generate(self._world_seed)
         skin = 1.5 * cfg.max_speed * cfg.dt / cfg.substeps
         if cfg.start is not None:
             pose = np.asarray(cfg.start, dtype=np.float64)
             self.world.check_start(pose, cfg.robot_radius + skin)
-        elif self.world.clearance(np.zeros((1, 2)))[0] >= 1.5 * cfg.robot_radius + skin:
-            pose = np.array([0.0, 0.0, heading])
+        elif cfg.start_rule == "origin":
+            heading = float(self.np_random.uniform(-math.pi, math.pi))
+            if self.world.clearance(np.zeros((1, 2)))[0] >= 1.5 * cfg.robot_radius + skin:
+                pose = np.array([0.0, 0.0, heading])
+            else:
+                pose = self.world.sample_free_pose(self.np_random, 1.5 * cfg.robot_radius + skin)
         else:
-            pose = self.world.sample_free_pose(self.np_random, 1.5 * cfg.robot_radius + skin)
+            pose = self.world.sample_reachable_pose(self.np_random, 1.5 * cfg.robot_radius + skin)
         self.sim = RobotSim(
             self.world, cfg.robot_radius, pose, cfg.max_force, cfg.max_torque, skin, cfg.dynamics
         )
@@ -213,12 +226,10 @@ class ExploreEnv(gym.Env):
         assert self.sim is not None and self.world is not None
         sim = self.sim
         pose = sim.pose
-        ranges = self.suite.true_ranges(self.world, pose)
-        bounds = self.suite.range_bounds(self.world, pose, sim.pose_error)
+        ranges, bounds = self.suite.sense(self.world, pose, sim.pose_error)  # true_ranges, range_bounds
         pymunk = sim.dynamics == "pymunk"
-        record = measure_step(self.t, self.suite, bounds, sim.speed_hull, sim.yaw_hull, pose[2],
-                              self.config.noise, self.np_random,
-                              lateral=sim.lateral_hull if pymunk else None)  # fmt: skip
+        record = record_step(self.t, self.suite, bounds, sim.hulls, pose[2], sim.measured, self.config.noise,
+                             self.np_random)  # fmt: skip
         states = taus = None
         if pymunk:
             states, taus = sim.states, sim.taus  # fresh arrays each step (the durations shared, read-only)

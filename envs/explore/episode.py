@@ -42,11 +42,14 @@ class Episode:
     @staticmethod
     def load(path: str | Path) -> Episode:
         """Load an episode saved by :meth:`save` (one saved before a field existed gets its old meaning:
-        unicycle dynamics, no lateral velocity, no substep path)."""
+        unicycle dynamics, no lateral velocity, no substep path, the exact thesis room and the origin start
+        rule)."""
         with np.load(path) as z:
             data = dict(z)
         cfg: dict[str, Any] = json.loads(str(data["config"]))
         cfg.setdefault("dynamics", "unicycle")  # saved before pymunk dynamics: every robot was a unicycle
+        if "room_jitter" not in cfg:  # saved before procedural maps: the exact room, the origin start rule
+            cfg.update(room_jitter=0.0, start_rule="origin")
         if cfg.get("start") is not None:
             cfg["start"] = tuple(cfg["start"])
         truth = GroundTruth(**{f.name: data.get("truth_" + f.name) for f in fields(GroundTruth)})

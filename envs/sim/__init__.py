@@ -62,9 +62,10 @@ from .noise import (
     outliers,
 )
 from .noise_jit import (
+    MEASURE_LATERAL,
+    MEASURE_MEAN,
     MODEL_CODES,
     RecordModel,
-    StepTruth,
     noise_kernel,
     obs_kernel,
     record_kernel,
@@ -95,6 +96,7 @@ from .sensors import (
     Hull,
     SensorSuite,
     measure_step,
+    record_step,
 )
 from .tracing import (
     chain_rings,
@@ -115,6 +117,8 @@ __all__ = [
     "GENERATORS",
     "Hull",
     "MIXED",
+    "MEASURE_LATERAL",
+    "MEASURE_MEAN",
     "MODEL_CODES",
     "ROBOT_TYPE",
     "ROBOT_FRICTION",
@@ -125,7 +129,6 @@ __all__ = [
     "RoomsCorridors",
     "SWEEP_POINTS",
     "SensorSuite",
-    "StepTruth",
     "THESIS_LOOP",
     "THESIS_ROOM",
     "ThesisRoom",
@@ -149,6 +152,7 @@ __all__ = [
     "mask_edges",
     "measure",
     "measure_step",
+    "record_step",
     "noise_kernel",
     "obs_kernel",
     "outliers",

@@ -48,6 +48,21 @@ sums by the outward-rounded interval operations of :mod:`digslam.observer.core.s
 bound widens by ``h²/2 |w_1| + 2 h |w_2|``); the lateral bound is at least ``±h |w_1|`` wide, which is the
 truth: the chord direction is fixed over a substep while the heading turns.
 
+**The mean velocity in the start frame** (rows 3 and 4 of :func:`step_bounds`: the odometry increment).
+The hulls above span every change of velocity within the step, so with inertia (a step that starts at rest
+and ends at full speed) they are as wide as the change itself, and the position bound they give,
+``dt R([ψ]) [v]``, grows by ``dt`` times that width every step. A robot's odometry also reports what it
+integrated over the step: the body-frame velocity rotated by the relative heading its gyro measured,
+
+    v̄ = (1/dt) ∫ R(ψ(t) − ψ(t_0)) v(t) dt = (1/dt) R(−a_0) (p_S − p_0),
+
+the displacement over the step in the body frame at its start, per second (``∫ R(ψ) v dt = p_S − p_0``:
+the path is continuous). It does not widen when the velocity changes within the step. Enclosed from the
+stored floats: ``p_S − p_0`` outward, ``cos a_0``, ``sin a_0`` by libm widened, the rotation's products and
+sums and the division by ``dt = Σ τ_j`` (an exact float sum: its partial sums are the ``s_j``)
+outward-rounded. The observer turns it into ``x_k − x_{k−1} ∈ [dt] R([ψ_{k−1}]) [v̄]``
+(:func:`digslam.observer.online.pose_jit.mean_displacement`).
+
 **The premise guard** (:func:`substep_clear`). The observer digs the robot's disc of radius ``r`` along its
 path, so the disc centred anywhere on the segment ``p_j → p_{j+1}`` must keep off every obstacle:
 ``dist(P, E) ≥ r`` for the segment ``P`` and every wall edge ``E``. For segments that do not cross,
@@ -226,16 +241,36 @@ def _cos_sin(m: float) -> tuple[float, float, float, float]:
     return max(wdn(c), -1.0), min(wup(c), 1.0), max(wdn(s), -1.0), min(wup(s), 1.0)
 
 
+@njit(inline="always")
+def _unrotate(xl: float, xh: float, yl: float, yh: float, cl: float, ch: float, sl: float, sh: float
+              ) -> tuple[float, float, float, float]:  # fmt: skip
+    """Outward bounds of ``R(−m) (x, y) = (cos m · x + sin m · y, cos m · y − sin m · x)`` for
+    ``x ∈ [xl, xh]``, ``y ∈ [yl, yh]``, ``cos m ∈ [cl, ch]``, ``sin m ∈ [sl, sh]``."""
+    pl, ph = imul(xl, xh, cl, ch)
+    ql, qh = imul(yl, yh, sl, sh)
+    al, ah = iadd(pl, ph, ql, qh)
+    pl, ph = imul(yl, yh, cl, ch)
+    ql, qh = imul(xl, xh, sl, sh)
+    bl, bh = isub(pl, ph, ql, qh)
+    return al, ah, bl, bh
+
+
 @njit
 def step_bounds(states: np.ndarray, taus: np.ndarray, out: np.ndarray) -> None:
-    """Rigorous hulls over a step of the true forward velocity ``v_1``, leftward velocity ``v_2`` and yaw
-    rate, written into ``out (3, 2)`` (rows speed, lateral, yaw rate; ``[lo, hi]``), from the stored states
-    ``(S + 1, 3)`` (``x, y, angle`` before the step and after each substep) and the durations ``τ (S,)``
-    (see the module)."""
+    """Rigorous bounds over a step, written into ``out (5, 2)`` (``[lo, hi]`` rows): the hulls of the true
+    forward velocity ``v_1``, leftward velocity ``v_2`` and yaw rate at every instant, then the mean velocity
+    ``(v̄_1, v̄_2)`` over the step in the body frame at its start (``[0, 0]`` twice for no substep); from the
+    stored states ``(S + 1, 3)`` (``x, y, angle`` before the step and after each substep) and the durations
+    ``τ (S,)`` (see the module)."""
+    if out.shape[0] != 5 or out.shape[1] != 2 or states.shape[0] != taus.shape[0] + 1:
+        raise ValueError("step_bounds: expected out (5, 2) and states (S + 1, 3) for taus (S,)")
     lo1, hi1, lo2, hi2 = math.inf, -math.inf, math.inf, -math.inf
     wlo, whi = math.inf, -math.inf
+    m1l, m1h, m2l, m2h = 0.0, 0.0, 0.0, 0.0
+    dt = 0.0
     for j in range(taus.shape[0]):
         tau = taus[j]
+        dt += tau  # exact (see the module)
         x0, y0, a0 = states[j, 0], states[j, 1], states[j, 2]
         x1, y1, a1 = states[j + 1, 0], states[j + 1, 1], states[j + 1, 2]
         uxl, uxh = _rate(sub_dn(x1, x0), sub_up(x1, x0), tau)
@@ -249,22 +284,20 @@ def step_bounds(states: np.ndarray, taus: np.ndarray, out: np.ndarray) -> None:
         else:
             cel, ceh, sel, seh = -1.0, 1.0, -1.0, 1.0
         cl, ch, sl, sh = _cos_sin(m)
-        pl, ph = imul(uxl, uxh, cl, ch)
-        ql, qh = imul(uyl, uyh, sl, sh)
-        w1l, w1h = iadd(pl, ph, ql, qh)
-        pl, ph = imul(uyl, uyh, cl, ch)
-        ql, qh = imul(uxl, uxh, sl, sh)
-        w2l, w2h = isub(pl, ph, ql, qh)
-        pl, ph = imul(cel, ceh, w1l, w1h)
-        ql, qh = imul(sel, seh, w2l, w2h)
-        v1l, v1h = iadd(pl, ph, ql, qh)
-        pl, ph = imul(cel, ceh, w2l, w2h)
-        ql, qh = imul(sel, seh, w1l, w1h)
-        v2l, v2h = isub(pl, ph, ql, qh)
+        w1l, w1h, w2l, w2h = _unrotate(uxl, uxh, uyl, uyh, cl, ch, sl, sh)
+        v1l, v1h, v2l, v2h = _unrotate(w1l, w1h, w2l, w2h, cel, ceh, sel, seh)
         lo1, hi1, lo2, hi2 = min(lo1, v1l), max(hi1, v1h), min(lo2, v2l), max(hi2, v2h)
         yl, yh = yaw_rate_bounds(a0, a1, tau)
         wlo, whi = min(wlo, yl), max(whi, yh)
     out[0, 0], out[0, 1], out[1, 0], out[1, 1], out[2, 0], out[2, 1] = lo1, hi1, lo2, hi2, wlo, whi
+    n = taus.shape[0]
+    if dt > 0.0:  # the mean velocity in the start frame, R(-a_0) (p_S - p_0) / dt (see the module)
+        dxl, dxh = sub_dn(states[n, 0], states[0, 0]), sub_up(states[n, 0], states[0, 0])
+        dyl, dyh = sub_dn(states[n, 1], states[0, 1]), sub_up(states[n, 1], states[0, 1])
+        cl, ch, sl, sh = _cos_sin(states[0, 2])
+        w1l, w1h, w2l, w2h = _unrotate(dxl, dxh, dyl, dyh, cl, ch, sl, sh)
+        (m1l, m1h), (m2l, m2h) = _rate(w1l, w1h, dt), _rate(w2l, w2h, dt)
+    out[3, 0], out[3, 1], out[4, 0], out[4, 1] = m1l, m1h, m2l, m2h
 
 
 __all__ = [

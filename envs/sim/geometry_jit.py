@@ -18,6 +18,7 @@ bounding-box pre-filter fused in (an edge whose box lies farther than
 * :func:`sector_bounds_kernel` -- rigorous bounds of the TRUE sector distance (from the true pose, within
   the simulator's proved pose error, floating point included): the record's range intervals are built on
   them, while :func:`sector_kernel` gives the float value the rewards and the rendering use.
+* :func:`sense_kernel` -- both of the above in one pass over the edges, bit for bit (the env's step).
 
 The robot's swept-disc checks (:mod:`.robot_jit`) reuse the scalar helpers :func:`edge_near` and
 :func:`segment_distance`.
@@ -264,6 +265,23 @@ def _edge_cone(edge: _Edge, px: np.ndarray, py: np.ndarray, pn: np.ndarray, pe: 
     return lo, hi
 
 
+@njit(inline="always")
+def _bound_cones(edge: _Edge, px: np.ndarray, py: np.ndarray, pn: np.ndarray, pe: np.ndarray, near: float,
+                 back: np.ndarray, lo: np.ndarray, hi: np.ndarray, ux: np.ndarray, uy: np.ndarray,
+                 cg: np.ndarray, w: np.ndarray, e_u: np.ndarray, e_w: np.ndarray, sh: np.ndarray,
+                 whole: np.ndarray) -> None:  # fmt: skip
+    """Lower ``lo``, ``hi`` (per cone) by the bounds of :func:`_edge_cone` for one edge, skipping the cones
+    with no apex shift (``back`` not finite) and those the edge cannot improve (``near``: no apex is nearer
+    to any point of it)."""
+    for s in range(lo.shape[0]):
+        if not math.isfinite(back[s]) or (near >= lo[s] and near >= hi[s]):
+            continue
+        cone = _ConeBounds(ux[s], uy[s], cg[s], w[s, 0], w[s, 1], w[s, 2], w[s, 3], e_u[s], e_w[s, 0],
+                           e_w[s, 1], sh[s], whole[s])  # fmt: skip
+        d_lo, d_hi = _edge_cone(edge, px, py, pn, pe, cone)
+        lo[s], hi[s] = min(lo[s], d_lo), min(hi[s], d_hi)
+
+
 @njit
 def sector_bounds_kernel(x: float, y: float, th: float, alpha: np.ndarray, gamma: np.ndarray,
                          edges: np.ndarray, bbox: np.ndarray, reach: float, perr: float,
@@ -343,13 +361,7 @@ def sector_bounds_kernel(x: float, y: float, th: float, alpha: np.ndarray, gamma
             seg = min(seg, pn[j] - pe[j])
         near = seg - shift_max * (1.0 + 16.0 * _U)  # no apex is nearer to any point of the edge
         edge = _Edge(ax, ay, dx, dy, npts, seg, e_pt)
-        for s in range(S):
-            if not math.isfinite(back[s]) or (near >= lo[s] and near >= hi[s]):
-                continue
-            cone = _ConeBounds(ux[s], uy[s], cg[s], w[s, 0], w[s, 1], w[s, 2], w[s, 3], e_u[s], e_w[s, 0],
-                               e_w[s, 1], sh[s], whole[s])  # fmt: skip
-            d_lo, d_hi = _edge_cone(edge, px, py, pn, pe, cone)
-            lo[s], hi[s] = min(lo[s], d_lo), min(hi[s], d_hi)
+        _bound_cones(edge, px, py, pn, pe, near, back, lo, hi, ux, uy, cg, w, e_u, e_w, sh, whole)
     cap = reach * (1.0 - 16.0 * _U) - 1.5 * perr - 4.0 * _U * mag
     for s in range(S):
         if not math.isfinite(back[s]):
@@ -359,6 +371,128 @@ def sector_bounds_kernel(x: float, y: float, th: float, alpha: np.ndarray, gamma
         out[s, 1] = add_up(hi[s], back[s])
 
 
+@njit
+def sense_kernel(pose: np.ndarray, cones: np.ndarray, edges: np.ndarray, bbox: np.ndarray, reach: float,
+                 perr: float, dist: np.ndarray, bounds: np.ndarray) -> None:  # fmt: skip
+    """:func:`sector_kernel` and :func:`sector_bounds_kernel` in one pass over the edges, written in place.
+
+    ``cones`` is ``(3, S)``: the directions ``alpha``, half-apertures ``gamma`` and maximum ranges ``r_max``
+    of the sectors. ``dist`` is what :func:`sector_kernel` writes with ``cut = r_max`` and ``reach`` (the
+    witnesses are not kept), ``bounds`` what :func:`sector_bounds_kernel` writes with the reach
+    ``reach * (1 + 1e-9) + 1e-9`` and ``perr`` (as :meth:`.sensors.SensorSuite.true_ranges` and
+    :meth:`.sensors.SensorSuite.range_bounds` call them): the same floating-point operations on the same
+    values, bit for bit, sharing the cone directions and boundary rays, the edges' pre-filter and the
+    candidate points the two kernels compute alike (``tests/envs/sim/test_sense.py`` checks it). ``pose`` is
+    ``(x, y, theta)``.
+    """
+    x, y, th = pose[0], pose[1], pose[2]
+    S, E = cones.shape[1], edges.shape[0]
+    # the cones: sector_kernel's directions and rays are sector_bounds_kernel's (the same expressions)
+    work = np.empty((8, S))  # one allocation for the per-cone values
+    ux, uy, cg, e_u, sh, back, lo, hi = work[0], work[1], work[2], work[3], work[4], work[5], work[6], work[7]
+    w = np.empty((S, 4))
+    e_w = np.empty((S, 2))
+    whole = np.empty(S, dtype=np.bool_)
+    mag = abs(x) + abs(y)
+    shift_max = 0.0
+    for s in range(S):
+        gamma = cones[1, s]
+        a = th + cones[0, s]
+        ux[s], uy[s], cg[s] = math.cos(a), math.sin(a), math.cos(gamma)
+        e_u[s] = 2.0 * _U * abs(a) + _ETA + _LU
+        for b in range(2):
+            c = a - gamma if b == 0 else a + gamma
+            w[s, 2 * b], w[s, 2 * b + 1] = math.cos(c), math.sin(c)
+            e_w[s, b] = 2.0 * _U * (abs(a) + abs(c)) + 2.0 * _ETA + _LU
+        whole[s] = gamma >= math.pi
+        base = 1.5 * perr + 4.0 * _U * mag + 4.0 * _ETA
+        sh[s] = 0.0
+        if not whole[s]:
+            sg = math.sin(gamma) - _LU - 2.0 * e_u[s] - 4.0 * _U
+            sh[s] = base / sg * (1.0 + 16.0 * _U) if sg > 0.0 else math.inf
+        if math.isfinite(sh[s]):
+            shift_max = max(shift_max, sh[s])
+        back[s] = (base + sh[s] * (1.0 + 2.0 * e_u[s] + 4.0 * _U)) * (1.0 + 16.0 * _U)
+        lo[s], hi[s] = math.inf, math.inf
+        dist[s] = _INF
+    reach_t2 = reach * reach  # sector_kernel's pre-filter
+    reach_b = reach * (1.0 + 1e-9) + 1e-9  # range_bounds' reach
+    r2 = reach_b + shift_max
+    reach2 = r2 * r2 * (1.0 + 16.0 * _U)
+    pts = np.empty((7, 3))  # sector_kernel's candidates and their norms, then sector_bounds_kernel's
+    tx, ty, tn, px, py, pn, pe = pts[0], pts[1], pts[2], pts[3], pts[4], pts[5], pts[6]
+    for k in range(E):
+        # edge_near's test against both reaches (reach2 >= reach_t2): one distance, two comparisons
+        bx = max(max(bbox[k, 0] - x, x - bbox[k, 2]), 0.0)
+        by = max(max(bbox[k, 1] - y, y - bbox[k, 3]), 0.0)
+        bd2 = bx * bx + by * by
+        keep_t, keep_b = bd2 <= reach_t2, bd2 <= reach2
+        if not (keep_t or keep_b):
+            continue
+        ax, ay = edges[k, 0] - x, edges[k, 1] - y
+        dx, dy = edges[k, 2] - edges[k, 0], edges[k, 3] - edges[k, 1]
+        dd = dx * dx + dy * dy
+        npts = 2
+        fx = fy = fn = 0.0
+        if dd > 0.0:  # the foot: the same expression in both kernels
+            t = min(max(-(ax * dx + ay * dy) / dd, 0.0), 1.0)
+            fx, fy = ax + t * dx, ay + t * dy
+            fn = math.hypot(fx, fy)
+            npts = 3
+        an = math.hypot(ax, ay)
+        if keep_t:
+            tx[0], ty[0], tx[1], ty[1] = ax, ay, ax + dx, ay + dy
+            tn[0], tn[1] = an, math.hypot(tx[1], ty[1])
+            tx[2], ty[2], tn[2] = fx, fy, fn
+            near_t = npts - 1
+            if npts == 2 and tn[1] < tn[0]:
+                near_t = 1
+            cross = ax * dy - ay * dx
+            for s in range(S):
+                if tn[near_t] >= dist[s]:
+                    continue
+                if cones[1, s] >= math.pi:  # the whole plane
+                    dist[s] = tn[near_t]
+                    continue
+                for j in range(npts):
+                    nj = tn[j]
+                    if nj < dist[s] and ux[s] * tx[j] + uy[s] * ty[j] >= nj * cg[s]:
+                        dist[s] = nj
+                for b in range(2):
+                    wxb, wyb = w[s, 2 * b], w[s, 2 * b + 1]
+                    den = wxb * dy - wyb * dx
+                    if den == 0.0:
+                        continue
+                    r = cross / den
+                    sp = (wyb * ax - wxb * ay) / den
+                    if r >= 0.0 and sp >= 0.0 and sp <= 1.0 and r < dist[s]:
+                        dist[s] = r
+        if not keep_b:
+            continue
+        size = abs(ax) + abs(ay) + abs(dx) + abs(dy)
+        e_pt = 16.0 * _U * (size + mag) + 16.0 * _ETA
+        px[0], py[0], pn[0] = ax, ay, an
+        px[1], py[1] = edges[k, 2] - x, edges[k, 3] - y
+        pn[1] = math.hypot(px[1], py[1])
+        px[2], py[2], pn[2] = fx, fy, fn
+        seg = math.inf
+        for j in range(npts):
+            pe[j] = e_pt + 4.0 * _LU * pn[j]
+            seg = min(seg, pn[j] - pe[j])
+        near = seg - shift_max * (1.0 + 16.0 * _U)
+        edge = _Edge(ax, ay, dx, dy, npts, seg, e_pt)
+        _bound_cones(edge, px, py, pn, pe, near, back, lo, hi, ux, uy, cg, w, e_u, e_w, sh, whole)
+    cap = reach_b * (1.0 - 16.0 * _U) - 1.5 * perr - 4.0 * _U * mag
+    for s in range(S):
+        if not dist[s] <= cones[2, s]:
+            dist[s] = _INF
+        if not math.isfinite(back[s]):
+            bounds[s, 0], bounds[s, 1] = 0.0, math.inf
+            continue
+        bounds[s, 0] = max(min(sub_dn(lo[s], back[s]), cap), 0.0)
+        bounds[s, 1] = add_up(hi[s], back[s])
+
+
 __all__ = [
     "edge_boxes",
     "edge_near",
@@ -366,4 +500,5 @@ __all__ = [
     "sector_bounds_kernel",
     "sector_kernel",
     "segment_distance",
+    "sense_kernel",
 ]

@@ -69,30 +69,10 @@ def _pad(v: float, tol: float, sign: float) -> float:
     return v + sign * (tol * max(1.0, a))
 
 
-class StepTruth(NamedTuple):
-    """The true values of one step that its record bounds (:func:`record_kernel`).
-
-    Attributes:
-        range_bounds: ``(n, 2)`` bounds of each true sector distance (``[r, r]`` where it is known exactly;
-            ``inf`` where nothing lies in the sector).
-        speed_lo, speed_hi: the hull of the true forward (body-frame) velocities over the step.
-        yaw_lo, yaw_hi: the hull of the true yaw rates over the step.
-        heading: the true heading at the record.
-        lateral_lo, lateral_hi: the hull of the true leftward (body-frame) velocities over the step.
-        measure_lateral: whether the leftward velocity is measured (a Doppler velocity log, with the speed's
-            noise bound; pymunk dynamics) or known to lie in its hull (a unicycle: ``[0, 0]`` exactly,
-            recorded as it is, with no draw).
-    """
-
-    range_bounds: np.ndarray
-    speed_lo: float
-    speed_hi: float
-    yaw_lo: float
-    yaw_hi: float
-    heading: float
-    lateral_lo: float = 0.0
-    lateral_hi: float = 0.0
-    measure_lateral: bool = False
+#: Rows of the hull array :func:`record_kernel` reads (the order of :func:`.dynamics_jit.step_bounds`).
+SPEED, LATERAL, YAW, MEAN1, MEAN2 = 0, 1, 2, 3, 4
+#: Bits of ``measured``: the lateral velocity, the odometry increment (the mean velocity, two components).
+MEASURE_LATERAL, MEASURE_MEAN = 1, 2
 
 
 class RecordModel(NamedTuple):
@@ -118,45 +98,58 @@ class RecordModel(NamedTuple):
 
 
 @njit
-def record_kernel(truth: StepTruth, noise: RecordModel, u: np.ndarray, outlier: np.ndarray,
-                  outlier_lo: np.ndarray, outlier_hi: np.ndarray, out: np.ndarray, no_echo: np.ndarray
-                  ) -> int:  # fmt: skip
-    """Intervals of one step into ``out (n + 4, 2)`` (speed, yaw rate, heading, the ``n`` ranges, then the
-    lateral velocity); ``no_echo``.
+def record_kernel(r_b: np.ndarray, hulls: np.ndarray, heading: float, measured: int, noise: RecordModel,
+                  u: np.ndarray, outlier: np.ndarray, outlier_lo: np.ndarray, outlier_hi: np.ndarray,
+                  out: np.ndarray, no_echo: np.ndarray) -> int:  # fmt: skip
+    """Intervals of one step into ``out (n + 6, 2)`` (speed, yaw rate, heading, the ``n`` ranges, then the
+    lateral velocity and the two components of the odometry increment); ``no_echo``.
 
-    ``truth`` holds the speed, yaw-rate and lateral hulls, the true heading and the bounds of each true
-    sector distance (:class:`StepTruth`); ``noise`` the maximum ranges, the noise model and its bounds
-    (:class:`RecordModel`); ``u`` the step's uniform draws in ``[-1, 1)``: ``n + 3`` (speed, yaw rate,
-    heading, then the ranges), plus one for the lateral velocity when it is measured (its interval then
-    follows the speed's noise model and bound; unmeasured, it is the hull itself, unwidened, so a unicycle
-    draws exactly what it drew before the lateral velocity existed); ``outlier`` (bool) the range readings
-    replaced by an outlier, whose
-    intervals are ``[outlier_lo, outlier_hi]``. A hull ``[lo, hi]`` is reported as the noisy interval of
-    its midpoint widened by its half-width, so it contains the whole hull (under ``adversarial`` noise the
-    hull touches a bound). A reading is ``no_echo`` (``[r_max, inf]``) only when the lower bound exceeds
-    ``r_max``; one whose upper bound is not finite reads ``[min(lo, r_max), inf]``. Every finite bound is
-    widened by ``noise.tol``. Returns the first row whose interval has a NaN or ``lo > hi`` (the checks of
+    The truth: ``r_b (n, 2)`` bounds of each true sector distance (``[r, r]`` where it is known exactly;
+    ``inf`` where nothing lies in the sector), ``hulls (5, 2)`` the hulls over the step of the true forward
+    velocity, leftward velocity and yaw rate and the bounds of the odometry increment's two components (rows
+    :data:`SPEED`, :data:`LATERAL`, :data:`YAW`, :data:`MEAN1`, :data:`MEAN2`, as
+    :func:`.dynamics_jit.step_bounds` writes them), the true ``heading``, and ``measured``, the bits
+    :data:`MEASURE_LATERAL` (a Doppler velocity log, with the speed's noise bound; unmeasured, the lateral
+    row is known to be the hull, ``[0, 0]`` for a unicycle, and is recorded as it is) and
+    :data:`MEASURE_MEAN` (unmeasured: ``[-inf, inf]`` twice). ``noise`` holds the maximum ranges, the noise
+    model and its bounds (:class:`RecordModel`); ``u`` the step's uniform draws in ``[-1, 1)``: ``n + 3``
+    (speed, yaw rate, heading, then the ranges), plus one for the lateral velocity when it is measured (so a
+    unicycle draws exactly what it drew before the lateral velocity existed), plus two for the increment
+    when it is measured; ``outlier`` (bool) the range readings replaced by an outlier, whose intervals are
+    ``[outlier_lo, outlier_hi]``. A hull ``[lo, hi]`` is reported as the noisy interval of its midpoint
+    widened by its half-width, so it contains the whole hull (under ``adversarial`` noise the hull touches a
+    bound). A reading is ``no_echo`` (``[r_max, inf]``) only when the lower bound exceeds ``r_max``; one
+    whose upper bound is not finite reads ``[min(lo, r_max), inf]``. Every finite bound is widened by
+    ``noise.tol``. Returns the first row whose interval has a NaN or ``lo > hi`` (the checks of
     :class:`~digslam.observer.slam.record.MissionRecord`), -1 if none.
     """
-    r_b, r_max = truth.range_bounds, noise.r_max
+    r_max = noise.r_max
     model, bias, b_range, tol = noise.model, noise.bias, noise.range, noise.tol
     flag, o_lo, o_hi = outlier, outlier_lo, outlier_hi
     n = r_b.shape[0]
     lat = n + 3
-    for k in range(3):
+    lateral, mean = (measured & MEASURE_LATERAL) != 0, (measured & MEASURE_MEAN) != 0
+    for k in range(5):
         if k == 0:
-            h_lo, h_hi, b, row, draw = truth.speed_lo, truth.speed_hi, noise.speed, 0, 0
+            src, b, row, draw = SPEED, noise.speed, 0, 0
         elif k == 1:
-            h_lo, h_hi, b, row, draw = truth.yaw_lo, truth.yaw_hi, noise.yaw_rate, 1, 1
-        else:
-            h_lo, h_hi, b, row, draw = truth.lateral_lo, truth.lateral_hi, noise.speed, lat, lat
-            if not truth.measure_lateral:
-                out[lat, 0], out[lat, 1] = h_lo, h_hi
+            src, b, row, draw = YAW, noise.yaw_rate, 1, 1
+        elif k == 2:
+            src, b, row, draw = LATERAL, noise.speed, lat, lat
+            if not lateral:
+                out[lat, 0], out[lat, 1] = hulls[LATERAL, 0], hulls[LATERAL, 1]
                 continue
+        else:
+            row = lat + k - 2
+            src, b, draw = MEAN1 + k - 3, noise.speed, row if lateral else row - 1
+            if not mean:
+                out[row, 0], out[row, 1] = -math.inf, math.inf
+                continue
+        h_lo, h_hi = hulls[src, 0], hulls[src, 1]
         half = 0.5 * (h_hi - h_lo)
         _, lo, hi = _one(0.5 * (h_lo + h_hi), b, u[draw], model, bias)
         out[row, 0], out[row, 1] = min(lo - half, h_lo), max(hi + half, h_hi)  # exact containment of the hull
-    _, out[2, 0], out[2, 1] = _one(truth.heading, noise.heading, u[2], model, bias)
+    _, out[2, 0], out[2, 1] = _one(heading, noise.heading, u[2], model, bias)
     for s in range(n):
         a, z = r_b[s, 0], r_b[s, 1]
         no_echo[s] = not a <= r_max[s]
@@ -175,8 +168,8 @@ def record_kernel(truth: StepTruth, noise: RecordModel, u: np.ndarray, outlier: 
         else:
             out[3 + s, 0], out[3 + s, 1] = max(lo, 0.0), hi
     bad = -1
-    for k in range(n + 4):
-        if tol > 0 and (k < lat or truth.measure_lateral):
+    for k in range(n + 6):
+        if tol > 0 and (k < lat or (k == lat and lateral) or (k > lat and mean)):
             out[k, 0], out[k, 1] = _pad(out[k, 0], tol, -1.0), _pad(out[k, 1], tol, 1.0)
         if bad < 0 and not out[k, 0] <= out[k, 1]:
             bad = k
@@ -209,9 +202,15 @@ def obs_kernel(rng: np.ndarray, no_echo: np.ndarray, speed: np.ndarray, lateral:
 
 
 __all__ = [
+    "LATERAL",
+    "MEAN1",
+    "MEAN2",
+    "MEASURE_LATERAL",
+    "MEASURE_MEAN",
     "MODEL_CODES",
+    "SPEED",
+    "YAW",
     "RecordModel",
-    "StepTruth",
     "noise_kernel",
     "obs_kernel",
     "record_kernel",

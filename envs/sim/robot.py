@@ -8,29 +8,31 @@ the guaranteed observer (:mod:`digslam.observer.slam.record`): ``x' = R(psi) v``
 inside the hulls at every instant.
 
 **pymunk** (``dynamics="pymunk"``, the default). The robot is a pymunk body (a disc of mass 1 and the moment
-of a uniform disc of radius ``radius``) driven the way pymunk's own top-down examples drive one: a
-kinematic control body pulls it through a ``PivotJoint`` (``max_bias = 0``: a pure velocity constraint;
-``max_force``: the drive's force limit, so the body has inertia and lags the command) and a ``GearJoint``
-(``max_bias = 0``, ``max_force = max_torque``). Each substep the control body's velocity is set from the
-command ``(v, omega)`` in the body frame: ``v`` along the body's current heading, ``omega`` its angular
-velocity. Walls are static ``pymunk.Segment`` shapes with friction (:data:`WALL_FRICTION`) and no
-elasticity, so the robot skids along them and friction turns it; contacts are pymunk's. (An earlier version
-drove the robot so with a unicycle record: the body's velocity lagged its heading, by up to 0.5 rad on
-reversals, and slid along walls, motions no unicycle with the recorded heading explains. The record's
-lateral velocity and the rigorous hulls below close that gap.) The collision circle has radius
-``radius + skin``. A step of ``dt`` seconds runs ``substeps`` pymunk steps whose durations are exact floats
-summing exactly to ``dt`` (:func:`.dynamics_jit.substep_times`). The truth is the piecewise-linear path
-through the states read back after each substep (:mod:`.dynamics_jit`: exact by definition, so
-``pose_error = 0``); its body-frame velocity and yaw rate are bounded rigorously over the step
-(:func:`.dynamics_jit.step_bounds`); the heading over the step lies in the hull of the substep headings and
-moves linearly between them, at a rate inside the yaw-rate hull. **The premise by construction**: after
-every substep the disc of radius ``radius`` centred anywhere on the segment from the previous state must be
-proved off every wall (:func:`.dynamics_jit.substep_clear`, rigorous float geometry that also catches
-tunnelling through thin walls; away from walls the cheaper :func:`.dynamics_jit.free_radius` proves it for
-the whole step). If it is not, the substep is undone: the body goes back to the previous state with zero
-velocity and angular velocity (a hard stop) and :attr:`~RobotSim.stops` counts it. The skin keeps pymunk's
-contacts off the disc, so hard stops are rare (``tests/envs/sim/test_dynamics.py``). A bump is a contact
-that begins while the robot touched no wall (pymunk's collision ``begin``).
+of a uniform disc of radius ``radius``) driven the way pymunk's own top-down examples drive one: a kinematic
+control body pulls it through a ``PivotJoint`` (``max_bias = 0``: a pure velocity constraint; ``max_force``:
+the drive's force limit, so the body has inertia and lags the command) and a ``GearJoint`` (``max_bias = 0``,
+``max_force = max_torque``). Each substep the control body's velocity is set from the command ``(v, omega)``
+in the body frame: ``v`` along the body's current heading, ``omega`` its angular velocity. Walls are static
+``pymunk.Segment`` shapes with friction (:data:`WALL_FRICTION`) and no elasticity, so the robot skids along
+them and friction turns it; contacts are pymunk's. (An earlier version drove the robot so with a unicycle
+record: the body's velocity lagged its heading, by up to 0.5 rad on reversals, and slid along walls, motions
+no unicycle with the recorded heading explains. The record's lateral velocity and the rigorous hulls below
+close that gap.) The collision circle has radius ``radius + skin``. A step of ``dt`` seconds runs ``substeps``
+pymunk steps whose durations are exact floats summing exactly to ``dt`` (:func:`.dynamics_jit.substep_times`).
+The truth is the piecewise-linear path through the states read back after each substep (:mod:`.dynamics_jit`:
+exact by definition, so ``pose_error = 0``); its body-frame velocity and yaw rate are bounded rigorously over
+the step (:func:`.dynamics_jit.step_bounds`), and so is the odometry increment (:attr:`~RobotSim.mean_hull`:
+the velocity averaged over the step in the body frame at its start, tight when inertia or a contact changes
+the velocity within the step, where the hulls are as wide as the change); the heading over the step lies in
+the hull of the substep headings and moves linearly between them, at a rate inside the yaw-rate hull. **The
+premise by construction**: after every substep the disc of radius ``radius`` centred anywhere on the segment
+from the previous state must be proved off every wall (:func:`.dynamics_jit.substep_clear`, rigorous float
+geometry that also catches tunnelling through thin walls; away from walls the cheaper
+:func:`.dynamics_jit.free_radius` proves it for the whole step). If it is not, the substep is undone: the body
+goes back to the previous state with zero velocity and angular velocity (a hard stop) and
+:attr:`~RobotSim.stops` counts it. The skin keeps pymunk's contacts off the disc, so hard stops are rare
+(``tests/envs/sim/test_dynamics.py``). A bump is a contact that begins while the robot touched no wall
+(pymunk's collision ``begin``).
 
 **unicycle** (``dynamics="unicycle"``, the thesis's missions' model). Exact unicycle kinematics, blocked
 (never sliding) by the world's walls: the robot follows the exact arcs of :mod:`.arc_jit` at constant speed
@@ -56,6 +58,7 @@ import pymunk
 from digslam.envs.config import DYNAMICS
 from digslam.envs.sim import geometry_jit as gjit
 from digslam.envs.sim.dynamics_jit import free_radius, step_bounds, substep_clear, substep_times
+from digslam.envs.sim.noise_jit import MEASURE_LATERAL, MEASURE_MEAN
 from digslam.envs.sim.robot_jit import robot_step_kernel
 from digslam.envs.sim.world import World
 
@@ -136,9 +139,16 @@ class RobotSim:
         self.bbox = gjit.edge_boxes(self.edges)
         self._pose = np.array([float(pose[0]), float(pose[1]), float(pose[2])])
         self._v, self._w, self._lat, self._blocked = 0.0, 0.0, 0.0, False
-        self.speed_hull: tuple[float, float] = (0.0, 0.0)
-        self.lateral_hull: tuple[float, float] = (0.0, 0.0)
-        self.yaw_hull: tuple[float, float] = (0.0, 0.0)
+        #: The odometry over the last step, ``(5, 2)`` rows ``[lo, hi]``: the hulls of the forward velocity,
+        #: the leftward velocity and the yaw rate, then the odometry increment's two components (pymunk,
+        #: :func:`.dynamics_jit.step_bounds`; the unicycle's lateral row is ``[0, 0]`` and its increment is
+        #: not measured, ``[-inf, inf]``). Overwritten each step: copy what you keep.
+        self.hulls = np.zeros((5, 2))
+        #: The bits of :data:`.noise_jit.MEASURE_LATERAL` and :data:`.noise_jit.MEASURE_MEAN` this robot's
+        #: record measures (pymunk: both; the unicycle: neither).
+        self.measured = MEASURE_LATERAL | MEASURE_MEAN if dynamics == "pymunk" else 0
+        if dynamics != "pymunk":
+            self.hulls[3:] = (-math.inf, math.inf)
         #: The last step's pieces ``(v, tau, theta_end)`` (:mod:`.arc_jit`; unicycle; NaN under pymunk); at
         #: reset, at rest.
         self.pieces = np.array([[0.0, 0.0, self._pose[2]], [0.0, 0.0, self._pose[2]]])
@@ -152,7 +162,6 @@ class RobotSim:
         #: Proved bound on ``max(|x - x_true|, |y - y_true|)`` of :attr:`pose` (the heading is exact; 0 under
         #: pymunk, whose stored states are the truth).
         self.pose_error = 0.0
-        self._hulls = np.zeros((3, 2))
         self._times: dict[tuple[float, int], tuple[np.ndarray, list[float]]] = {}
 
     def _begin(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
@@ -211,11 +220,7 @@ class RobotSim:
             rows.append((x, y, a))
         states = np.array(rows)
         self._pose[0], self._pose[1], self._pose[2] = x, y, a
-        h = self._hulls
-        step_bounds(states, taus, h)
-        self.speed_hull = (float(h[0, 0]), float(h[0, 1]))
-        self.lateral_hull = (float(h[1, 0]), float(h[1, 1]))
-        self.yaw_hull = (float(h[2, 0]), float(h[2, 1]))
+        step_bounds(states, taus, self.hulls)
         # the true velocity at the step's end (floats): the last substep's, in the body frame at angle a_S
         tau, (xp, yp, ap) = tau_list[-1], rows[-2]
         ux, uy = (x - xp) / tau, (y - yp) / tau
@@ -245,15 +250,40 @@ class RobotSim:
         if bumped:
             self.bumps += 1
         self._blocked = rest > 0
+        h = self.hulls
         if rest and first:
-            self.speed_hull = (min(v, vi), max(v, vi))
+            h[0, 0], h[0, 1] = min(v, vi), max(v, vi)
         else:
-            self.speed_hull = (vi, vi) if rest else (v, v)
+            h[0, 0] = h[0, 1] = vi if rest else v
         self._v, self._w = (vi if rest else v), 0.5 * (w_lo + w_hi)
-        self.yaw_hull = (w_lo, w_hi)
+        h[2, 0], h[2, 1] = w_lo, w_hi
         self.body.position = (float(self._pose[0]), float(self._pose[1]))
         self.body.angle = float(self._pose[2])
         return int(bumped)
+
+    @property
+    def speed_hull(self) -> tuple[float, float]:
+        """Hull of the true forward velocity over the last step (m/s)."""
+        return float(self.hulls[0, 0]), float(self.hulls[0, 1])
+
+    @property
+    def lateral_hull(self) -> tuple[float, float]:
+        """Hull of the true leftward velocity over the last step (m/s; ``(0, 0)`` for the unicycle)."""
+        return float(self.hulls[1, 0]), float(self.hulls[1, 1])
+
+    @property
+    def yaw_hull(self) -> tuple[float, float]:
+        """Hull of the true yaw rate over the last step (rad/s)."""
+        return float(self.hulls[2, 0]), float(self.hulls[2, 1])
+
+    @property
+    def mean_hull(self) -> tuple[tuple[float, float], tuple[float, float]] | None:
+        """Bounds ``((v̄_1⁻, v̄_1⁺), (v̄_2⁻, v̄_2⁺))`` of the velocity averaged over the last step in the body
+        frame at its start (pymunk); None under the unicycle, which does not measure it."""
+        if not self.measured & MEASURE_MEAN:
+            return None
+        h = self.hulls
+        return (float(h[3, 0]), float(h[3, 1])), (float(h[4, 0]), float(h[4, 1]))
 
     @property
     def pose(self) -> np.ndarray:

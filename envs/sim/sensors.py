@@ -25,12 +25,14 @@ import numpy as np
 from digslam.envs.config import ExploreConfig, NoiseConfig
 from digslam.envs.sim import geometry_jit as gjit
 from digslam.envs.sim.noise import outliers
-from digslam.envs.sim.noise_jit import MODEL_CODES, RecordModel, StepTruth, record_kernel
+from digslam.envs.sim.noise_jit import MEASURE_LATERAL, MEASURE_MEAN, MODEL_CODES, RecordModel, record_kernel
 from digslam.envs.sim.world import World
 from digslam.observer.slam.record import MissionRecord
 
 Hull = float | tuple[float, float]
 _ROWS = ("speed", "yaw_rate", "heading")
+_TAIL = ("lateral", "mean_velocity[0]", "mean_velocity[1]")
+_UNMEASURED = ((-math.inf, math.inf), (-math.inf, math.inf))
 
 
 def _hull(v: Hull) -> tuple[float, float]:
@@ -70,6 +72,7 @@ class SensorSuite:
         # kernel keeps the first (uncached) compilation short
         for name in ("alpha", "gamma", "r_max"):
             object.__setattr__(self, "_k_" + name, getattr(self, name).copy())
+        object.__setattr__(self, "_k_cones", np.stack([self.alpha, self.gamma, self.r_max]))  # sense()
         object.__setattr__(self, "_model", (None, None, None))  # (noise, tol, its RecordModel): measure_step
 
     @classmethod
@@ -110,6 +113,16 @@ class SensorSuite:
                                   float(pose_error), out)  # fmt: skip
         return out
 
+    def sense(self, world: World, pose: np.ndarray, pose_error: float) -> tuple[np.ndarray, np.ndarray]:
+        """``(true_ranges(world, pose), range_bounds(world, pose, pose_error))``, bit for bit, in one compiled
+        pass over the edges (:func:`.geometry_jit.sense_kernel`): what the env computes each step."""
+        p = pose
+        if not (type(p) is np.ndarray and p.dtype == np.float64 and p.shape == (3,)):
+            p = np.array([float(pose[0]), float(pose[1]), float(pose[2])])
+        d, out = np.empty(self.n), np.empty((self.n, 2))
+        gjit.sense_kernel(p, self._k_cones, world.edges, world.bbox, self._reach, float(pose_error), d, out)
+        return d, out
+
 
 def measure_step(
     t: float,
@@ -122,6 +135,7 @@ def measure_step(
     rng: np.random.Generator,
     tol: float = 0.0,
     lateral: Hull | None = None,
+    mean: tuple[Hull, Hull] | None = None,
 ) -> MissionRecord:
     """Noisy record of one step from the true values.
 
@@ -131,12 +145,26 @@ def measure_step(
     of its midpoint widened by its half-width, so it contains the whole hull (under ``adversarial`` noise
     the hull touches a bound). ``lateral`` is the leftward velocity (value or hull), measured like the speed
     (same noise bound ``noise.speed``, one more draw); None (a unicycle) records ``[0, 0]`` exactly with no
-    draw. The random generator is advanced by the same amount whatever the values, so runs stay
-    reproducible.
+    draw. ``mean`` is the body-frame velocity ``(v̄_1, v̄_2)`` averaged over the step (values or hulls; an
+    integrating DVL, same noise bound, two more draws); None records ``[-inf, inf]`` twice (not measured).
+    The random generator is advanced by the same amount whatever the values, so runs stay reproducible.
     """
     (s_lo, s_hi), (w_lo, w_hi) = _hull(speed), _hull(yaw_rate)
-    measured = lateral is not None
-    l_lo, l_hi = _hull(lateral) if measured else (0.0, 0.0)  # type: ignore[arg-type]
+    l_lo, l_hi = _hull(lateral) if lateral is not None else (0.0, 0.0)
+    (a_lo, a_hi), (b_lo, b_hi) = (_hull(mean[0]), _hull(mean[1])) if mean is not None else _UNMEASURED
+    hulls = np.array([[s_lo, s_hi], [l_lo, l_hi], [w_lo, w_hi], [a_lo, a_hi], [b_lo, b_hi]])
+    measured = (MEASURE_LATERAL if lateral is not None else 0) | (MEASURE_MEAN if mean is not None else 0)
+    return record_step(t, suite, ranges, hulls, heading, measured, noise, rng, tol)
+
+
+def record_step(t: float, suite: SensorSuite, ranges: np.ndarray, hulls: np.ndarray, heading: float,
+                measured: int, noise: NoiseConfig, rng: np.random.Generator, tol: float = 0.0
+                ) -> MissionRecord:  # fmt: skip
+    """:func:`measure_step` with the odometry as one float64 array ``hulls (5, 2)`` (rows: forward speed,
+    leftward velocity, yaw rate, then the odometry increment's two components; the order of
+    :func:`.dynamics_jit.step_bounds`, whose output the env passes as it is) and ``measured`` the bits
+    :data:`~.noise_jit.MEASURE_LATERAL` and :data:`~.noise_jit.MEASURE_MEAN` (unmeasured: the lateral row
+    is recorded as it is, the increment as ``[-inf, inf]``); the env's per-step path."""
     n = suite.n
     r = ranges
     if not (type(r) is np.ndarray and r.dtype == np.float64 and r.shape == (n, 2) and r.flags.c_contiguous):
@@ -146,21 +174,21 @@ def measure_step(
         elif r.shape != (n, 2):
             raise ValueError(f"ranges: expected shape ({n},) or ({n}, 2), got {r.shape}")
         r = np.ascontiguousarray(r)
-    u = rng.uniform(-1.0, 1.0, n + 4 if measured else n + 3)
+    # n + 3 draws, one more for the lateral velocity, two more for the increment (MEASURE_MEAN == 2)
+    u = rng.uniform(-1.0, 1.0, n + 3 + (measured & MEASURE_LATERAL) + (measured & MEASURE_MEAN))
     if noise.outlier_prob > 0:
         flag, o_lo, o_hi = outliers(n, noise.outlier_prob, suite.r_max, noise.range, rng, noise.max_outliers)
     else:
         flag = np.zeros(n, dtype=bool)
         o_lo = o_hi = suite._k_r_max
-    out, no_echo = np.empty((n + 4, 2)), np.empty(n, dtype=bool)
+    out, no_echo = np.empty((n + 6, 2)), np.empty(n, dtype=bool)
     model = suite._model  # the kernel's RecordModel, built once per noise configuration
     if model[0] is not noise or model[1] != tol:
         model = (noise, tol, _record_model(suite, noise, tol))
         object.__setattr__(suite, "_model", model)
-    truth = StepTruth(r, s_lo, s_hi, w_lo, w_hi, float(heading), l_lo, l_hi, measured)
-    bad = record_kernel(truth, model[2], u, flag, o_lo, o_hi, out, no_echo)
+    bad = record_kernel(r, hulls, float(heading), measured, model[2], u, flag, o_lo, o_hi, out, no_echo)
     if bad >= 0:
-        name = _ROWS[bad] if bad < 3 else ("lateral" if bad == n + 3 else f"range[{bad - 3}]")
+        name = _ROWS[bad] if bad < 3 else f"range[{bad - 3}]" if bad < n + 3 else _TAIL[bad - n - 3]
         raise ValueError(f"{name}: interval is not [lo <= hi]: {out[bad].tolist()}")
     t = float(t)
     if not math.isfinite(t):
@@ -190,10 +218,11 @@ def _record(
         alpha=suite.alpha,
         gamma=suite.gamma,
         r_max=suite.r_max,
-        range=out[3:-1],
+        range=out[3:-3],
         no_echo=no_echo,
         outlier=flag,
-        lateral=out[-1],
+        lateral=out[-3],
+        mean_velocity=out[-2:],
     )
     return rec
 
@@ -202,4 +231,5 @@ __all__ = [
     "Hull",
     "SensorSuite",
     "measure_step",
+    "record_step",
 ]

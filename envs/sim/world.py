@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from digslam.envs.sim import geometry as geo
-from digslam.envs.sim.raster import rasterize
+from digslam.envs.sim.raster import FREE, cell_centres, rasterize
 from digslam.envs.sim.tracing import chain_rings
 
 
@@ -97,6 +97,45 @@ class World:
             if len(ok):
                 return np.array([pts[ok[0], 0], pts[ok[0], 1], rng.uniform(-np.pi, np.pi)])
         raise ValueError(f"start: no free pose with clearance {clearance} found in map {self.name!r}")
+
+    def reachable_cells(self, clearance: float, resolution: float = 0.1) -> np.ndarray:
+        """The cells (of :meth:`raster`'s grid, row 0 at ``ymin``) of the largest 8-connected region where a
+        disc of radius ``clearance`` centred anywhere in the cell keeps off every obstacle: the space a robot
+        of that clearance can roam, away from pockets it cannot reach. Conservative (a cell counts when its
+        centre lies ``clearance + resolution`` from every cell not entirely free); cached, read-only."""
+        from scipy import ndimage
+
+        cache = self.__dict__.setdefault("_reachable", {})
+        key = (float(clearance), float(resolution))
+        if key not in cache:
+            free = self.raster(resolution) == FREE
+            room = ndimage.distance_transform_edt(free) * resolution  # centre to the nearest non-free centre
+            ok = room - 1.5 * resolution >= clearance
+            lab, n = ndimage.label(ok, structure=np.ones((3, 3), dtype=bool))
+            if n == 0:
+                best = np.zeros_like(ok)
+            else:
+                best = lab == 1 + int(np.argmax(np.bincount(lab.ravel())[1:]))
+            best.flags.writeable = False
+            cache[key] = best
+        return cache[key]
+
+    def sample_reachable_pose(
+        self, rng: np.random.Generator, clearance: float, resolution: float = 0.1, tries: int = 64
+    ) -> np.ndarray:
+        """A pose ``(x, y, theta)`` drawn uniformly in the reachable region (:meth:`reachable_cells`), with at
+        least ``clearance`` to every obstacle (checked exactly) and a uniform heading; ValueError naming
+        ``start`` when the world has no such region."""
+        cells = self.reachable_cells(clearance, resolution)
+        ii, jj = np.nonzero(cells)
+        if ii.size:
+            xs, ys = cell_centres(self.frame, resolution)
+            for _ in range(tries):
+                k = int(rng.integers(ii.size))
+                p = np.array([xs[jj[k]], ys[ii[k]]]) + rng.uniform(-0.5, 0.5, 2) * resolution
+                if self.clearance(p[None])[0] >= clearance:
+                    return np.array([p[0], p[1], rng.uniform(-np.pi, np.pi)])
+        raise ValueError(f"start: no reachable free pose with clearance {clearance} in map {self.name!r}")
 
     def check_start(self, pose: np.ndarray, clearance: float) -> None:
         """Raise ``ValueError`` naming ``start`` if the pose is not free with ``clearance`` to obstacles."""

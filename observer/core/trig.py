@@ -74,10 +74,20 @@ def tan(a: Pair) -> Pair:
     lo, hi = a
     e = empty_mask(lo, hi)
     tlo, thi = _quadrants(lo, hi)
-    pole = _unresolved(lo, hi, tlo, thi) | _has_integer(tlo, thi, 1, 2)
+    tlo_u, thi_d = _quadrants(hi, lo)[::-1]  # the other ends: [lo/(π/2)] is [tlo, tlo_u]
     with np.errstate(invalid="ignore"):
-        rlo = np.where(lo == 0, 0.0, rnd.widen_down(np.tan(lo)))
-        rhi = np.where(hi == 0, 0.0, rnd.widen_up(np.tan(hi)))
+        tan_lo, tan_hi = np.tan(lo), np.tan(hi)
+        # a pole only possibly at an end (within the enclosure of lo/(π/2)): a float is never a pole, and
+        # next to a pole |tan| is huge with the sign of the side it lies on (libm's error is a few ulps)
+        mid = _has_integer(np.nextafter(tlo_u, _INF), np.nextafter(thi_d, -_INF), 1, 2)  # surely inside
+        near_lo = _has_integer(tlo, np.minimum(tlo_u, thi), 1, 2)
+        near_hi = _has_integer(np.maximum(thi_d, tlo), thi, 1, 2)
+        lone = (near_lo ^ near_hi) & ~mid  # one candidate pole, at one end only
+        clear = lone & ((near_lo & (tan_lo < 0)) | (near_hi & (tan_hi > 0)))
+    pole = _unresolved(lo, hi, tlo, thi) | (_has_integer(tlo, thi, 1, 2) & ~clear)
+    with np.errstate(invalid="ignore"):
+        rlo = np.where(lo == 0, 0.0, rnd.widen_down(tan_lo))
+        rhi = np.where(hi == 0, 0.0, rnd.widen_up(tan_hi))
     return set_empty(np.where(pole, -_INF, rlo) + 0.0, np.where(pole, _INF, rhi) + 0.0, e)
 
 

@@ -4,7 +4,8 @@ Lives here: :mod:`.expr` (``Expr``, ``Function``: the expression DAG, natural an
 :mod:`.ops`
 (the elementary functions as expression nodes), :mod:`.backward` (the minimal backward step of every
 operator, Sec. 3.2.2, used by forward-backward contractors), :mod:`.centred` (interval Jacobians and centred
-forms, Sec. 2.3.3). Kernels: :mod:`.tape_jit` (a function compiled to a tape and run per box),
+forms, Sec. 2.3.3), :mod:`.centred_ctc` (the centred backward contraction, Eq. 2.20). Kernels:
+:mod:`.tape_jit` (a function compiled to a tape and run per box),
 :mod:`.hc4_jit` (HC4 forward-backward on the tape), :mod:`.centred_jit` (Jacobian and centred form on the
 tape).
 
@@ -40,6 +41,9 @@ from .centred import (
     centred_image_numpy,
     jacobian,
     jacobian_numpy,
+)
+from .centred_ctc import (
+    centred_contract,
 )
 from .centred_jit import (
     ad_row,
@@ -150,6 +154,7 @@ __all__ = [
     "b_tan",
     "centre_outputs",
     "centre_row",
+    "centred_contract",
     "centred_image",
     "centred_image_numpy",
     "centred_tape",

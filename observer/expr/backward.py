@@ -52,9 +52,11 @@ def b_mul(z: Pair, x: Pair, y: Pair, p: object) -> tuple[Pair, ...]:
 
 
 def b_div(z: Pair, x: Pair, y: Pair, p: object) -> tuple[Pair, ...]:
-    # z = x / y  <=>  x = z·y with y != 0
+    # z = x / y  <=>  x = z·y with y != 0: a divisor left at {0} leaves no point
     x = inter(x, A.mul(z, y))
-    return x, mul_rev(x, z, y)
+    y = mul_rev(x, z, y)
+    zero = (y[0] == 0) & (y[1] == 0)
+    return A.set_empty(*x, zero), A.set_empty(*y, zero)
 
 
 def b_neg(z: Pair, x: Pair, p: object) -> tuple[Pair, ...]:
@@ -153,12 +155,12 @@ _2PI = (rnd.TWO_PI_DOWN, rnd.TWO_PI_UP)
 def b_sin(z: Pair, x: Pair, p: object) -> tuple[Pair, ...]:
     a = T.asin(z)  # ⊂ [-π/2, π/2]; preimage: [a] + 2kπ and π - [a] + 2kπ
     pi = (np.full_like(a[0], _PI[0]), np.full_like(a[0], _PI[1]))
-    return (_periodic_rev(x, [a, A.sub(pi, a)], _2PI),)
+    return (A.set_empty(*_periodic_rev(x, [a, A.sub(pi, a)], _2PI), a[0] > a[1]),)  # z ∩ [-1, 1] = ∅
 
 
 def b_cos(z: Pair, x: Pair, p: object) -> tuple[Pair, ...]:
     a = T.acos(z)  # ⊂ [0, π]; preimage: ±[a] + 2kπ
-    return (_periodic_rev(x, [a, A.neg(a)], _2PI),)
+    return (A.set_empty(*_periodic_rev(x, [a, A.neg(a)], _2PI), a[0] > a[1]),)
 
 
 def b_tan(z: Pair, x: Pair, p: object) -> tuple[Pair, ...]:

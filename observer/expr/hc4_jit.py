@@ -100,6 +100,8 @@ def _rule(op: int, zl: float, zh: float, xl: float, xh: float, yl: float, yh: fl
         tl, th = imul(zl, zh, yl, yh)
         xl, xh = meet(xl, xh, tl, th)
         yl, yh = mul_rev(xl, xh, zl, zh, yl, yh)
+        if yl == 0.0 and yh == 0.0:  # a divisor left at {0}: no point
+            return _INF, -_INF, _INF, -_INF
         return xl, xh, yl, yh
     pl, ph = meet(zl, zh, 0.0, _INF)
     if op == NEG:

@@ -62,6 +62,7 @@ from digslam.observer.core.scalar_jit import (
 __all__ = [
     "CellAxes",
     "CellSets",
+    "NO_MEAN",
     "GridFrame",
     "PoseBox",
     "SectorBatch",
@@ -177,6 +178,11 @@ class SectorBatch(NamedTuple):
     disk: np.ndarray
 
 
+#: The mean velocity of a record that does not measure it (``MissionRecord``'s default): never written.
+NO_MEAN = np.array([[-math.inf, math.inf], [-math.inf, math.inf]])
+NO_MEAN.flags.writeable = False
+
+
 class StepRecord(NamedTuple):
     """One single-step record as the filter's kernels read it: the fields of a single-step
     :class:`~digslam.observer.slam.record.MissionRecord` and the duration of the step that ends at it.
@@ -191,6 +197,8 @@ class StepRecord(NamedTuple):
             maximum ranges.
         ranges: ``(n, 2)`` the range intervals (``[r_max, inf]`` where ``no_echo``).
         no_echo: ``(n,)`` bool, True where nothing lies in the cone up to ``r_max``.
+        mean_velocity: ``(2, 2)`` the body-frame velocity averaged over the step (rows ``v̄_1``, ``v̄_2``;
+            ``[-inf, inf]`` twice when not measured, the default).
     """
 
     dt: float
@@ -203,6 +211,7 @@ class StepRecord(NamedTuple):
     r_max: np.ndarray
     ranges: np.ndarray
     no_echo: np.ndarray
+    mean_velocity: np.ndarray = NO_MEAN
 
 
 @njit(inline="always")

@@ -72,7 +72,7 @@ import numpy as np
 
 from digslam.observer.core import rounding as rnd
 from digslam.observer.core.config import Config, check, check_int, config_dataclass
-from digslam.observer.online.dig_jit import CellSets, PoseBox, StepRecord
+from digslam.observer.online.dig_jit import NO_MEAN, CellSets, PoseBox, StepRecord
 from digslam.observer.online.mark_jit import dig_and_mark_q
 from digslam.observer.online.step_jit import filter_step_q
 from digslam.observer.online.window import WindowDigMap
@@ -113,10 +113,12 @@ _NO_SLIP = np.zeros(2)
 
 def _step_record(rec: MissionRecord, dt: float) -> StepRecord:
     """The kernels' view of a single-step record (:class:`.dig_jit.StepRecord`): its arrays, not copied
-    (``lateral`` unset, as in a record built without ``MissionRecord.__init__``: ``[0, 0]``, a unicycle)."""
+    (``lateral`` unset, as in a record built without ``MissionRecord.__init__``: ``[0, 0]``, a unicycle;
+    ``mean_velocity`` unset: not measured)."""
     lat = rec.lateral if rec.lateral is not None else _NO_SLIP
+    mean = rec.mean_velocity if rec.mean_velocity is not None else NO_MEAN
     return StepRecord(dt, rec.speed, lat, rec.yaw_rate, rec.heading, rec.alpha, rec.gamma, rec.r_max,
-                      rec.range, rec.no_echo)  # fmt: skip
+                      rec.range, rec.no_echo, mean)  # fmt: skip
 
 
 class OnlineDigSlam:

@@ -6,7 +6,10 @@ contractor on the cells of one pose box (Eq. 6.22), outward rounded with :mod:`.
   ``x_k ∈ x_{k-1} + [dt]·R([ψ] on the slice)·[v_k]`` with the body-frame velocity ``v = (v_1, v_2)``
   (``x' = R(ψ) v``, Eq. 3.59, 6.12, B.20; the unicycle of Eq. 6.23 is ``v_2 = 0``): :func:`rotate` encloses
   ``R([ψ]) [v]``; every correctly rounded operation is stepped one ulp outward, ``cos``/``sin`` enclosed
-  by :func:`cos_sin`.
+  by :func:`cos_sin`. When the record also holds the odometry increment (``mean_velocity``: the velocity
+  averaged over the step in the body frame at its start), the displacement is intersected with
+  :func:`mean_displacement`'s, ``[dt]·R([ψ_{k-1}])·[v̄]``: it stays tight when the velocity changes within
+  the step (inertia, contacts), where ``[v]`` is as wide as the change.
 * :func:`impact_bound_q` is the radius of the impact constraint, q-relaxed (§2.6.2) when the filter allows
   ``q`` outliers per step: the ``(q + 1)``-th smallest upper range.
 * :func:`clearance_cells` bounds ``dist(p, comp M⁻)`` from below for the cells of a pose box: the centre
@@ -30,7 +33,16 @@ from digslam.observer.core.grid_jit import window
 from digslam.observer.core.scalar_jit import dn, iadd, imul, isub, njit, up
 from digslam.observer.online.dig_jit import GridFrame, PoseBox, StepRecord, cell_size, prod_hi, prod_lo
 
-__all__ = ["cos_sin", "rotate", "predict", "clearance_cells", "contract", "impact_bound", "impact_bound_q"]
+__all__ = [
+    "cos_sin",
+    "rotate",
+    "mean_displacement",
+    "predict",
+    "clearance_cells",
+    "contract",
+    "impact_bound",
+    "impact_bound_q",
+]
 
 #: Absolute widening of a libm ``cos``/``sin`` value (``|v| <= 1``): 4 ulps of 1 plus the subtraction's.
 TRIG_PAD = 2e-15
@@ -94,12 +106,29 @@ def rotate(v1l: float, v1h: float, v2l: float, v2h: float, cl: float, ch: float,
 
 
 @njit
+def mean_displacement(p_lo: float, p_hi: float, dtl: float, dth: float, mv: np.ndarray
+                      ) -> tuple[float, float, float, float]:  # fmt: skip
+    """The step's displacement ``(d_x⁻, d_y⁻, d_x⁺, d_y⁺)`` from the odometry increment: the mean velocity
+    ``[v̄] = mv (2, 2)`` over the step in the body frame at its start, ``v̄ = (1/dt) ∫ R(ψ(t) - ψ_{k-1}) v dt``
+    (a DVL integrated with the gyro's relative rotation; :mod:`digslam.observer.slam.record`). Since
+    ``x_k - x_{k-1} = ∫ R(ψ) v dt = R(ψ_{k-1}) dt v̄``, it lies in ``[dt]·R([ψ_{k-1}])·[v̄]`` with
+    ``[ψ_{k-1}] = [p_lo, p_hi]`` and ``[dtl, dth] ∋ dt`` (:func:`rotate`, outward rounded)."""
+    cl, ch, sl, sh = cos_sin(p_lo, p_hi)
+    u0l, u0h, u1l, u1h = rotate(mv[0, 0], mv[0, 1], mv[1, 0], mv[1, 1], cl, ch, sl, sh)
+    e0l, e0h = _mul(dtl, dth, u0l, u0h)
+    e1l, e1h = _mul(dtl, dth, u1l, u1h)
+    return e0l, e1l, e0h, e1h
+
+
+@njit
 def predict(prior: PoseBox, step: StepRecord
             ) -> tuple[bool, PoseBox, tuple[float, float, float, float]]:  # fmt: skip
     """One tube step from ``prior`` (``x' = R(ψ) v``, Eq. 3.59, 6.12, B.20; heading fused with the compass)
     with the odometry of ``step`` (its ``dt``, ``yaw_rate``, ``heading``, ``speed`` and ``lateral``):
     ``x_k ∈ x_{k-1} + [dt]·R([ψ])·[v]`` with ``[ψ]`` the heading over the whole slice and
     ``[v] = ([speed], [lateral])`` (:func:`rotate`); a unicycle step (``lateral = [0, 0]``) is Eq. 6.23's.
+    A measured ``mean_velocity`` (all four bounds finite) intersects the displacement with
+    :func:`mean_displacement`'s.
 
     Returns ``(ok, box, d)``: the predicted pose box (position and heading) and the displacement box
     ``d = (d_x⁻, d_y⁻, d_x⁺, d_y⁺)`` of the step; ``ok`` False (and NaNs) when the heading or its slice is
@@ -118,6 +147,17 @@ def predict(prior: PoseBox, step: StepRecord
     u0l, u0h, u1l, u1h = rotate(v[0], v[1], lat[0], lat[1], cl, ch, snl, snh)
     d0l, d0h = _mul(dtl, dth, u0l, u0h)
     d1l, d1h = _mul(dtl, dth, u1l, u1h)
+    mv = step.mean_velocity
+    if (
+        math.isfinite(mv[0, 0])
+        and math.isfinite(mv[0, 1])
+        and math.isfinite(mv[1, 0])
+        and math.isfinite(mv[1, 1])
+    ):
+        e0l, e1l, e0h, e1h = mean_displacement(prior.psi_lo, prior.psi_hi, dtl, dth, mv)
+        d0l, d0h, d1l, d1h = max(d0l, e0l), min(d0h, e0h), max(d1l, e1l), min(d1h, e1h)
+        if not (d0l <= d0h and d1l <= d1h):
+            return False, PoseBox(nan, nan, nan, nan, nan, nan), (nan, nan, nan, nan)
     box = PoseBox(
         dn(prior.x_lo + d0l), dn(prior.y_lo + d1l), up(prior.x_hi + d0h), up(prior.y_hi + d1h), hl, hh
     )

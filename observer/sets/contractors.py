@@ -22,6 +22,7 @@ from digslam.observer.core.boxes import chunked, empty_rows, normalize_empty, va
 from digslam.observer.core.interval import IntervalArray, as_pair
 from digslam.observer.core.types import Batch
 from digslam.observer.expr.backward import BACKWARD
+from digslam.observer.expr.centred_ctc import centred_contract
 from digslam.observer.expr.expr import Function
 from digslam.observer.expr.hc4_jit import hc4
 from digslam.observer.expr.tape_jit import Tape
@@ -154,6 +155,8 @@ class CtcFwdBwd(Ctc):
     (mean-value) form of :mod:`.centred` (Eq. 2.20, interval automatic differentiation on the DAG):
     tighter on small boxes when variables occur several times, at about twice the forward cost; off by
     default (the natural form is exact for functions where each variable occurs once, e.g. Ex. 2.7).
+    The result is then contracted once more by the centred backward pass of :mod:`.centred_ctc` (the
+    linear forward-backward on the mean-value form, as in codac's ``CtcInverse``).
     """
 
     def __init__(self, f: Function | Any, y: Any, centred: bool = False) -> None:
@@ -172,9 +175,13 @@ class CtcFwdBwd(Ctc):
     def contract(self, lo: np.ndarray, hi: np.ndarray) -> Batch:
         tape = Tape.of(self.f)
         if tape is not None:
-            return hc4(tape, lo, hi, *self.y, centred=self.centred)
-        f, y, centred = self.f, self.y, self.centred
-        return chunked(lambda a, b: hc4_backward(f, forward(f, a, b, centred), y, a, b), lo, hi)
+            res = hc4(tape, lo, hi, *self.y, centred=self.centred)
+        else:
+            f, y, centred = self.f, self.y, self.centred
+            res = chunked(lambda a, b: hc4_backward(f, forward(f, a, b, centred), y, a, b), lo, hi)
+        if not self.centred:
+            return res
+        return normalize_empty(*centred_contract(self.f, *res, self.y[0][None], self.y[1][None]))
 
 
 def forward(f: Function, lo: np.ndarray, hi: np.ndarray, centred: bool = False) -> list[Batch]:

@@ -18,9 +18,10 @@ from typing import Any
 
 import numpy as np
 
-from digslam.observer.core.boxes import chunked, empty_rows
-from digslam.observer.core.types import Batch
+from digslam.observer.core.boxes import chunked, empty_rows, normalize_empty
+from digslam.observer.core.types import Batch, Pair
 from digslam.observer.expr.centred import centred_image
+from digslam.observer.expr.centred_ctc import centred_contract
 from digslam.observer.expr.expr import Function
 from digslam.observer.expr.hc4_jit import hc4, image, sep_box
 from digslam.observer.expr.tape_jit import Tape
@@ -36,9 +37,11 @@ class SepInverse(Sep):
         y: an interval or number (``m = 1``), a box of dimension ``m``, or a :class:`Sep` on ``Rᵐ``.
 
         centred: intersect ``f``'s natural enclosure with its centred (mean-value) form before the
-            backward passes (:mod:`.centred`, Eq. 2.20): fewer bisections near the boundary when
-            variables occur several times; off by default (measured in
-            ``tests/observer/expr/test_centred.py``).
+            backward passes (:mod:`.centred`, Eq. 2.20), then contract both parts once more by the
+            centred backward pass (:mod:`.centred_ctc`): ``x_out`` with ``f(x) ∈ Y``, ``x_in`` with
+            each half-line of the complement of ``Y`` (hull of the pieces). Fewer bisections near the
+            boundary when variables occur several times, and sharper projections (:class:`.SepProj`);
+            off by default (measured in ``tests/observer/expr/test_centred.py``).
 
     Raises:
         ValueError: if ``y``'s dimension is not ``m``.
@@ -73,7 +76,7 @@ class SepInverse(Sep):
             return chunked(self._separate, lo, hi)
         if self.box is not None:
             res = sep_box(tape, lo, hi, self._y, self.centred)
-            return (res[0], res[1]), (res[2], res[3])
+            return self._centred_parts((res[0], res[1]), (res[2], res[3]))
         ylo, yhi = image(tape, lo, hi)
         if self.centred:
             ylo, yhi = inter_batch((ylo, yhi), centred_image(self.f, lo, hi))
@@ -83,9 +86,28 @@ class SepInverse(Sep):
 
     def separate_stacked(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         tape = Tape.of(self.f)
-        if tape is not None and self.box is not None:
+        if tape is not None and self.box is not None and not self.centred:
             return sep_box(tape, lo, hi, self._y, self.centred)
         return super().separate_stacked(lo, hi)
+
+    def _centred_parts(self, xin: Batch, xout: Batch) -> tuple[Batch, Batch]:
+        """With ``centred`` and a box ``Y``: both parts contracted once more by the centred backward pass
+        (:func:`.centred_ctc.centred_contract`); ``x_in`` piece by piece of the complement of ``Y``."""
+        if not self.centred or self.box is None:
+            return xin, xout
+        m, N = self.f.m, xin[0].shape[0]
+        ylo, yhi = np.broadcast_to(self._y[0], (N, m)), np.broadcast_to(self._y[1], (N, m))
+        xout = centred_contract(self.f, *xout, ylo, yhi)
+        acc = (np.full_like(xin[0], np.inf), np.full_like(xin[1], -np.inf))
+        for j in range(m):
+            for side in (0, 1):
+                plo, phi = np.full((N, m), -np.inf), np.full((N, m), np.inf)
+                if side == 0:
+                    phi[:, j] = ylo[:, j]
+                else:
+                    plo[:, j] = yhi[:, j]
+                acc = hull_batch(acc, centred_contract(self.f, *xin, plo, phi))
+        return normalize_empty(*acc), normalize_empty(*xout)
 
     def _separate(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Batch, Batch]:
         vals = forward(self.f, lo, hi, self.centred)
@@ -94,6 +116,12 @@ class SepInverse(Sep):
             yin, yout = self.sep_y.separate(*self.image(vals, lo.shape[0]))
             return hc4_backward(self.f, vals, yin, lo, hi), hc4_backward(self.f, vals, yout, lo, hi)
         xout = hc4_backward(self.f, vals, self.box.box, lo, hi)
+        xin = self._in_pieces(vals, lo, hi)
+        return self._centred_parts(xin, xout)
+
+    def _in_pieces(self, vals: list[Pair], lo: np.ndarray, hi: np.ndarray) -> Batch:
+        """``x_in`` of the numpy path: the hull of the backward projections of the complement's pieces."""
+        assert self.box is not None
         xin = (np.full_like(lo, np.inf), np.full_like(hi, -np.inf))
         for plo, phi in self.box.pieces(*self.image(vals, lo.shape[0])):
             live = plo[:, 0] <= phi[:, 0]
@@ -108,7 +136,7 @@ class SepInverse(Sep):
         dead = empty_rows(*self.image(vals, lo.shape[0])) & ~empty_rows(lo, hi)
         if dead.any():  # f defined nowhere on the box: all of it is outside f⁻¹(Y)
             xin[0][dead], xin[1][dead] = lo[dead], hi[dead]
-        return xin, xout
+        return xin
 
 
 __all__ = [

@@ -18,6 +18,8 @@ their bounds: the result then says so (``consistent`` is False) and carries no s
 Data contract (:mod:`.record`): ``speed[k]``, ``lateral[k]`` (the body-frame velocity ``v_1``, ``v_2``) and
 ``yaw_rate[k]`` bound the true values over the whole slice ``[t_{k-1}, t_k]`` that ends at ``t_k``;
 ``heading[k]`` bounds the heading at ``t_k``; ``range[k]`` bounds the ranges from the pose at ``t_k``.
+A measured odometry increment ``mean_velocity[k]`` also bounds the gate increment
+``x_k - x_{k-1} ∈ [dt]·R([ψ_{k-1}])·[v̄]`` (:func:`odometry_increment`, used by ``C_d/dt``'s gate passes).
 
 >>> from digslam.observer.slam.record import MissionRecord
 >>> n = 11
@@ -46,6 +48,7 @@ from digslam.observer.slam.explored import explored_disks_grid, explored_union
 from digslam.observer.slam.grid import Grid
 from digslam.observer.slam.record import MissionRecord
 from digslam.observer.thick.sep import CLEAR, DARK, UNKNOWN
+from digslam.observer.tube.ctc import increments
 from digslam.observer.tube.tube import Tube, body_velocity, ctc_deriv, heading_from_compass
 
 
@@ -161,6 +164,26 @@ def odometry_velocity(record: MissionRecord, heading: Tube) -> Pair:
     return body_velocity(v_lo, v_hi, heading.slice_lo[:, 0], heading.slice_hi[:, 0])
 
 
+def odometry_increment(record: MissionRecord, heading: Tube) -> Pair | None:
+    """Per-slice bounds of the gate increments ``x_{k+1} - x_k`` from the odometry increment
+    ``mean_velocity`` (the velocity averaged over the slice in the body frame at its start):
+    ``x_{k+1} - x_k = dt_k R(ψ_k) v̄`` lies in ``[dt_k]·R([ψ_k])·[v̄]`` with ``[ψ_k]`` the heading tube's gate
+    (:func:`~.tube.body_velocity` on the gates, :func:`~digslam.observer.tube.ctc.increments`, outward
+    rounded). None when no slice measures it (a unicycle record, or one saved before the field existed).
+
+    Returns:
+        ``(d_lo, d_hi)`` of shape ``(T, 2)`` (``[-inf, inf]`` on the slices that do not measure it), or None.
+    """
+    mv = record.mean_velocity[1:]
+    if not np.isfinite(mv).any():
+        return None
+    u_lo, u_hi = body_velocity(mv[..., 0], mv[..., 1], heading.gate_lo[:-1, 0], heading.gate_hi[:-1, 0])
+    d_lo, d_hi = increments(record.t, u_lo, u_hi)
+    unmeasured = ~np.isfinite(mv).all(axis=(1, 2))
+    d_lo[unmeasured], d_hi[unmeasured] = -np.inf, np.inf
+    return d_lo, d_hi
+
+
 def impact_bound(record: MissionRecord) -> np.ndarray:
     """Per time, the smallest upper range bound over the echoing sensors (``inf`` if none echoed)."""
     hi = np.where(record.no_echo, np.inf, record.range[..., 1])
@@ -197,10 +220,11 @@ def dig_slam(
         at = heading.inconsistent_at if heading.inconsistent_at is not None else heading.first_empty()
         return DigSlamResult(False, at, None, None, heading, 0)
     u_lo, u_hi = odometry_velocity(record, heading)
+    inc = odometry_increment(record, heading)
     n = t.shape[0]
     g_lo, g_hi = np.full((n, 2), -np.inf), np.full((n, 2), np.inf)
     g_lo[0], g_hi[0] = x0_lo, x0_hi
-    tube = ctc_deriv(Tube(t, g_lo, g_hi), u_lo, u_hi, forward=True, backward=False)
+    tube = ctc_deriv(Tube(t, g_lo, g_hi), u_lo, u_hi, forward=True, backward=False, increment=inc)
     dig = DigMap(grid)
     res = DigSlamResult(True, None, tube, dig, heading, 0, dead_reckoning=tube.widths())
     r_hi = impact_bound(record)
@@ -216,7 +240,7 @@ def dig_slam(
             lo, hi = dig.contract_impacts(tube.gate_lo, tube.gate_hi, r_hi)
             tube = Tube(t, lo, hi, tube.slice_lo, tube.slice_hi)
         after = tube.widths()
-        tube = ctc_deriv(tube, u_lo, u_hi)
+        tube = ctc_deriv(tube, u_lo, u_hi, increment=inc)
         res.iterations = it + 1
         res.widths.append({"before": before, "impacts": after, "deriv": tube.widths()})
         if tube.is_empty():
@@ -239,5 +263,6 @@ __all__ = [
     "dig_slam",
     "explored_zone",
     "impact_bound",
+    "odometry_increment",
     "odometry_velocity",
 ]

@@ -16,7 +16,13 @@ bound the true body-frame velocity ``v = (v_1, v_2)`` (forward, leftward; a Dopp
 rate at every instant of the WHOLE slice ``[t_{k-1}, t_k]`` that ends at ``t_k`` (not an instantaneous
 value); record 0's odometry bounds nothing the observers use. The position then obeys ``x' = R(psi) v``
 (Eq. 3.59, 6.12, B.20). A unicycle record (a robot that cannot slip sideways) has ``lateral = [0, 0]``,
-the default: records saved before the field existed load with it.
+the default: records saved before the field existed load with it. ``mean_velocity[k]`` (optional, ``(2, 2)``:
+rows forward, leftward) bounds the odometry increment: the velocity averaged over the slice in the body
+frame at its start, ``v̄ = (1/dt) ∫ R(psi(t) - psi(t_{k-1})) v(t) dt = (1/dt) R(-psi(t_{k-1})) (x_k -
+x_{k-1})`` (a DVL integrated with the gyro's relative rotation, as odometry reports pose increments); it
+stays tight when the velocity changes within the slice (inertia, contact), where the hull
+``speed x lateral`` cannot. Its default, ``[-inf, inf]`` twice, measures nothing (records saved before the
+field existed load with it).
 
 This module needs numpy only, so the observer can read missions without importing the simulator.
 
@@ -36,7 +42,13 @@ from pathlib import Path
 import numpy as np
 
 _PREFIX = "record_"
-_FLOAT_FIELDS = ("t", "speed", "yaw_rate", "heading", "alpha", "gamma", "r_max", "range", "lateral")
+_FLOAT_FIELDS = ("t", "speed", "yaw_rate", "heading", "alpha", "gamma", "r_max", "range", "lateral",
+                 "mean_velocity")  # fmt: skip
+#: Fields that default when absent (records saved before they existed).
+_OPTIONAL = ("lateral", "mean_velocity")
+#: ``mean_velocity`` of a record that does not measure it: the whole line for ``v_1`` and ``v_2``.
+UNMEASURED = np.array([[-np.inf, np.inf], [-np.inf, np.inf]])
+UNMEASURED.flags.writeable = False
 
 
 @dataclass(eq=False)
@@ -56,6 +68,9 @@ class MissionRecord:
         outlier: True where the reading is an injected outlier (its interval may miss the truth).
         lateral: Leftward body-frame velocity ``v_2`` interval (m/s), shape ``(..., 2)``; default ``[0, 0]``
             (a unicycle).
+        mean_velocity: The odometry increment: the velocity averaged over the slice that ends at the record,
+            in the body frame at the slice's start (m/s), shape ``(..., 2, 2)`` (rows forward, leftward;
+            columns ``lo``, ``hi``); default :data:`UNMEASURED`.
     """
 
     t: np.ndarray
@@ -69,11 +84,14 @@ class MissionRecord:
     no_echo: np.ndarray
     outlier: np.ndarray
     lateral: np.ndarray = None  # type: ignore[assignment]  # None: [0, 0] (set in __post_init__)
+    mean_velocity: np.ndarray = None  # type: ignore[assignment]  # None: UNMEASURED (set in __post_init__)
 
     def __post_init__(self) -> None:
         d = self.__dict__
         if d["lateral"] is None:
             d["lateral"] = np.zeros(np.shape(d["speed"]))
+        if d["mean_velocity"] is None:
+            d["mean_velocity"] = np.broadcast_to(UNMEASURED, np.shape(d["t"]) + (2, 2)).copy()
         for name in _FLOAT_FIELDS:
             d[name] = np.asarray(d[name], dtype=np.float64)
         d["no_echo"] = np.asarray(d["no_echo"], dtype=bool)
@@ -90,11 +108,13 @@ class MissionRecord:
                 raise ValueError(f"{name}: expected shape {lead + n}, got {getattr(self, name).shape}")
         if self.range.shape != lead + n + (2,):
             raise ValueError(f"range: expected shape {lead + n + (2,)}, got {self.range.shape}")
+        if self.mean_velocity.shape != lead + (2, 2):
+            raise ValueError(f"mean_velocity: expected shape {lead + (2, 2)}, got {self.mean_velocity.shape}")
         self._check_bounds()
 
     def _check_bounds(self) -> None:
         """Reject intervals with a NaN or ``lo > hi``, non-finite times and bad cone geometry."""
-        for name in ("speed", "yaw_rate", "heading", "range", "lateral"):
+        for name in ("speed", "yaw_rate", "heading", "range", "lateral", "mean_velocity"):
             v = getattr(self, name)
             bad = np.isnan(v).any(axis=-1) | (v[..., 0] > v[..., 1])
             if bad.any():
@@ -156,12 +176,13 @@ class MissionRecord:
     def from_arrays(
         arrays: dict[str, np.ndarray] | np.lib.npyio.NpzFile, prefix: str = _PREFIX
     ) -> MissionRecord:
-        """Inverse of :meth:`to_arrays`; raises ``KeyError`` naming a missing field (``lateral``, absent
-        from records saved before it existed, defaults to ``[0, 0]``)."""
+        """Inverse of :meth:`to_arrays`; raises ``KeyError`` naming a missing field (``lateral`` and
+        ``mean_velocity``, absent from records saved before they existed, default to ``[0, 0]`` and
+        :data:`UNMEASURED`)."""
         out = {}
         for f in fields(MissionRecord):
             key = prefix + f.name
-            if key not in arrays and f.name == "lateral":
+            if key not in arrays and f.name in _OPTIONAL:
                 continue
             if key not in arrays:
                 raise KeyError(f"{key}: missing from the record arrays")
@@ -180,5 +201,6 @@ class MissionRecord:
 
 
 __all__ = [
+    "UNMEASURED",
     "MissionRecord",
 ]

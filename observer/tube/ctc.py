@@ -164,14 +164,22 @@ def deriv_arrays(
     u: Pair,
     forward: bool = True,
     backward: bool = True,
+    increment: Pair | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, int | None]:
     """``C_d/dt`` on arrays (non-empty inputs): returns ``(gate_lo, gate_hi, slice_lo, slice_hi, bad)``.
 
+    ``increment`` (optional, ``(T, n)`` twice) bounds the gate increments ``x_{k+1} - x_k`` directly (e.g.
+    an odometry increment): the gate passes use its intersection with ``[dt_k]·[u_k]``; the slices still
+    use ``[0, dt_k]·[u_k]`` (an increment says nothing about the path inside the slice).
     ``bad`` is None, or the index of the first gate (or slice) found empty, in the order of the passes
     (gates against their slices, forward, backward, slices, gates): no trajectory is consistent.
     """
     (glo, ghi), (slo, shi) = gates, slices
-    d_lo, d_hi = increments(t, *u)
+    u_dlo, u_dhi = d_lo, d_hi = increments(t, *u)
+    if increment is not None:
+        d_lo, d_hi = np.maximum(d_lo, increment[0]), np.minimum(d_hi, increment[1])
+        if (d_lo > d_hi).any():  # the increment contradicts the velocity: slice k, so gate k + 1
+            return glo, ghi, slo, shi, _first(d_lo, d_hi) + 1  # type: ignore[operator]
     glo, ghi = glo.copy(), ghi.copy()  # gates inside both adjacent slices (slices are closed envelopes)
     glo[:-1], ghi[:-1] = np.maximum(glo[:-1], slo), np.minimum(ghi[:-1], shi)
     glo[1:], ghi[1:] = np.maximum(glo[1:], slo), np.minimum(ghi[1:], shi)
@@ -186,7 +194,7 @@ def deriv_arrays(
         ghi = _upper(ghi[::-1], -d_lo[::-1])[::-1]
         if (glo > ghi).any():
             return glo, ghi, slo, shi, _first(glo, ghi)
-    z_lo, z_hi = np.minimum(d_lo, 0.0), np.maximum(d_hi, 0.0)  # [0, dt]·[u] ⊂ hull(0, [d])
+    z_lo, z_hi = np.minimum(u_dlo, 0.0), np.maximum(u_dhi, 0.0)  # [0, dt]·[u] ⊂ hull(0, [d])
     with np.errstate(invalid="ignore"):
         slo = np.fmax(slo, np.fmax(rnd.add_down(glo[:-1], z_lo), rnd.sub_down(glo[1:], z_hi)))
         shi = np.fmin(shi, np.fmin(rnd.add_up(ghi[:-1], z_hi), rnd.sub_up(ghi[1:], z_lo)))

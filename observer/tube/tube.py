@@ -216,7 +216,8 @@ def _empty_like(x: Tube, at: int | None) -> Tube:
     return e
 
 
-def ctc_deriv(x: Tube, u_lo: ArrayLike, u_hi: ArrayLike, forward: bool = True, backward: bool = True) -> Tube:
+def ctc_deriv(x: Tube, u_lo: ArrayLike, u_hi: ArrayLike, forward: bool = True, backward: bool = True,
+              increment: Pair | None = None) -> Tube:  # fmt: skip
     """``C_d/dt`` for ``ẋ = u`` with ``u(τ) ∈ [u_k]`` for ``τ`` in slice ``k`` (Eq. 2.76, Remark 2.12).
 
     Gates ``x_{k+1} &= x_k + dt_k[u_k]`` (forward), ``x_k &= x_{k+1} - dt_k[u_k]`` (backward), slices
@@ -227,6 +228,8 @@ def ctc_deriv(x: Tube, u_lo: ArrayLike, u_hi: ArrayLike, forward: bool = True, b
         x: the tube to contract (not modified).
         u_lo, u_hi: ``(T, n)`` (or ``(T,)`` for ``n = 1``) derivative bounds per slice.
         forward, backward: which gate passes to run (the slices are always contracted).
+        increment: optional ``(T, n)`` bounds ``(d_lo, d_hi)`` of the gate increments ``x_{k+1} - x_k``
+            themselves (an odometry increment), intersected with ``dt_k[u_k]`` in the gate passes.
 
     Returns:
         A new tube; if the data are inconsistent (an empty gate, slice or ``[u_k]``), the tube whose
@@ -242,7 +245,7 @@ def ctc_deriv(x: Tube, u_lo: ArrayLike, u_hi: ArrayLike, forward: bool = True, b
     if (u[0] > u[1]).any():
         return _empty_like(x, int(np.argmax((u[0] > u[1]).any(axis=1))))
     glo, ghi, slo, shi, bad = deriv_arrays(
-        x.t, (x.gate_lo, x.gate_hi), (x.slice_lo, x.slice_hi), u, forward, backward
+        x.t, (x.gate_lo, x.gate_hi), (x.slice_lo, x.slice_hi), u, forward, backward, increment
     )
     return _empty_like(x, bad) if bad is not None else Tube._trusted(x.t, glo, ghi, slo, shi)
 

@@ -32,7 +32,8 @@ def test_default_file_is_the_default_config_and_overrides_are_typed() -> None:
     assert cfg.env_kwargs == {**TrainConfig().env_kwargs, "map_size": 48} and isinstance(cfg.gamma, float)
     assert cfg.override(["out_dir=plain"]).out_dir == "plain"  # an unquoted string stays a string
     assert parse_value("{map_size = 40, crop = 4.0}") == {"map_size": 40, "crop": 4.0}
-    assert TrainConfig().eval_seeds() == (500, 501, 502) and TrainConfig().train_seeds() == (0, 1)
+    assert TrainConfig().eval_seeds() == (1_000_000, 1_000_001, 1_000_002)  # the validation split
+    assert TrainConfig().train_seeds() == (0, 1)
 
 
 def test_config_files_toml_and_json(tmp_path) -> None:  # type: ignore[no-untyped-def]
@@ -63,6 +64,8 @@ def test_config_files_toml_and_json(tmp_path) -> None:  # type: ignore[no-untype
         ("n_steps=0", "n_steps"),
         ("gamma=1.5", "gamma"),
         ("eval_seed=1", "eval_seed"),  # held-out seeds meet the training seeds 0, 1
+        ("eval_seed=2000000", "eval_seed"),  # the test split: never for training or tuning
+        ("seed=1999999", "seed"),  # the training envs' seeds 1999999, 2000000 reach the test split
         ("seed.x=1", "seed.x"),
         ("noequals", "overrides"),
     ],

@@ -153,7 +153,7 @@ def test_an_episode_saved_before_pymunk_dynamics_loads_as_a_unicycle(tmp_path: P
     cfg = json.loads(str(data["config"]))
     del cfg["dynamics"]
     data["config"] = np.array(json.dumps(cfg))
-    for key in ("truth_lateral", "truth_states", "truth_taus", "record_lateral"):
+    for key in ("truth_lateral", "truth_states", "truth_taus", "record_lateral", "record_mean_velocity"):
         del data[key]
     np.savez(tmp_path / "old.npz", **data)
     old = Episode.load(tmp_path / "old.npz")
@@ -174,6 +174,21 @@ def test_pymunk_episode_keeps_its_path_and_lateral_velocity() -> None:
     assert np.all(np.isnan(truth.pieces))
     assert np.all(rec.lateral[:, 0] <= truth.lateral) and np.all(truth.lateral <= rec.lateral[:, 1])
     assert np.any(rec.lateral[1:, 1] - rec.lateral[1:, 0] > 0.0)
+    # the odometry increment: R(-psi_{k-1}) (x_k - x_{k-1}) / dt, inside the record, and narrow where the
+    # speed hull is wide (the robot speeds up from rest within the first step)
+    d = np.diff(truth.pose[:, :2], axis=0) / np.diff(truth.t)[:, None]
+    c, s = np.cos(truth.pose[:-1, 2]), np.sin(truth.pose[:-1, 2])
+    inc = np.column_stack([c * d[:, 0] + s * d[:, 1], c * d[:, 1] - s * d[:, 0]])
+    mean = rec.mean_velocity[1:]
+    assert np.all(mean[..., 0] <= inc + 1e-12) and np.all(inc - 1e-12 <= mean[..., 1])  # floats: see premise
+    assert np.all(mean[..., 1] - mean[..., 0] <= 2 * env.config.noise.speed + 1e-9)
+    assert np.max(rec.speed[1:, 1] - rec.speed[1:, 0]) > 0.5
+
+
+def test_a_unicycle_record_does_not_measure_the_increment() -> None:
+    ep = record_episode(ExploreEnv(world="rocks", dynamics="unicycle"), 4, _actions(5, 1))
+    assert ep.records.mean_velocity.shape == (6, 2, 2)
+    assert np.all(ep.records.mean_velocity == [[-np.inf, np.inf], [-np.inf, np.inf]])
 
 
 def test_render_modes(tmp_path: Path) -> None:
@@ -195,16 +210,70 @@ def test_render_modes(tmp_path: Path) -> None:
 
 
 def test_fixed_world_and_new_worlds() -> None:
-    env = ExploreEnv(world="rocks")
+    env = ExploreEnv(world="rocks", fixed_world=True)
     env.reset(seed=1)
     w = env.world
     env.reset()
     assert env.world is w
-    env = ExploreEnv(world="rocks", fixed_world=False)
+    env = ExploreEnv(world="rocks")  # the default: every episode a new level
     env.reset(seed=1)
     w = env.world
     env.reset()
     assert not np.array_equal(env.world.edges, w.edges)
+
+
+@pytest.mark.parametrize("world", ["room", "rocks", "caves", "rooms"])
+def test_every_seed_is_a_new_level_with_a_free_reachable_start(world: str) -> None:
+    """Different seeds give different worlds and starts, the same seed the same episode; every start is
+    free with the start clearance and lies in the reachable region (the largest one, not a pocket)."""
+    env = gym.make(f"digslam/Explore{'' if world == 'room' else world.capitalize()}-v0")
+    u = env.unwrapped
+    cfg = u.config
+    clearance = 1.5 * cfg.robot_radius + 1.5 * cfg.max_speed * cfg.dt / cfg.substeps
+    edges, starts = [], []
+    for seed in (0, 1, 2, 1_000_000, 2_000_000):
+        _, info = env.reset(seed=seed)
+        pose = info["truth"].pose
+        edges.append(u.world.edges.copy())
+        starts.append(pose.copy())
+        assert u.world.clearance(pose[None, :2])[0] >= clearance
+        cells = u.world.reachable_cells(clearance)
+        xs, ys = (u.world.frame[0], u.world.frame[1])
+        i, j = int((pose[1] - ys) / 0.1), int((pose[0] - xs) / 0.1)
+        assert cells[max(i - 1, 0) : i + 2, max(j - 1, 0) : j + 2].any()  # in (or next to) the region
+    for a in range(len(edges)):
+        for b in range(a):
+            assert edges[a].shape != edges[b].shape or not np.array_equal(edges[a], edges[b])
+            assert not np.array_equal(starts[a], starts[b])
+    acts = _actions(20, 3)
+    runs = []
+    for _ in range(2):
+        _, info = env.reset(seed=7)
+        recs = [info["record"]]
+        for a in acts:
+            recs.append(env.step(a)[4]["record"])
+        runs.append(MissionRecord.stack(recs))
+    assert runs[0] == runs[1]
+
+
+def test_map_seed_pins_the_world_and_the_splits_are_disjoint() -> None:
+    from digslam.envs import splits
+
+    env = ExploreEnv(world="rocks", map_seed=12)
+    env.reset(seed=0)
+    w = env.world
+    _, info = env.reset(seed=1)
+    assert env.world is w and not np.array_equal(info["truth"].pose, env.reset(seed=0)[1]["truth"].pose)
+    assert np.array_equal(ExploreEnv(world="rocks", map_seed=12).generator.generate(12).edges, w.edges)
+    names = [splits.split_of(s) for s in (0, 999_999, 1_000_000, 1_000_999, 2_000_000, 2_000_999)]
+    assert names == ["train", "train", "validation", "validation", "test", "test"]
+    assert not set(splits.TRAIN) & set(splits.VALIDATION) and not set(splits.VALIDATION) & set(splits.TEST)
+    with pytest.raises(ValueError, match="test split"):
+        splits.check_not_test("seed", [3, 2_000_004])
+    with pytest.raises(ValueError, match="map_seed"):
+        ExploreEnv(map_seed=-1)
+    with pytest.raises(ValueError, match="room_jitter"):
+        ExploreEnv(room_jitter=5.0)
 
 
 def test_bad_input_errors_name_the_field() -> None:

@@ -20,7 +20,14 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from premise import PREC, PremiseChecker, check_episode, segment_distance2, velocity_extremes
+from premise import (
+    PREC,
+    PremiseChecker,
+    check_episode,
+    mean_velocity_exact,
+    segment_distance2,
+    velocity_extremes,
+)
 
 from digslam.envs import ExploreEnv, World
 from digslam.envs.sim.dynamics_jit import free_radius, step_bounds, substep_clear, substep_times
@@ -82,7 +89,7 @@ def test_step_bounds_contain_the_exact_body_velocity(x: float, y: float, a: floa
         px, py, pa = states[-1]
         states.append((px + dx, py + dy, pa + da))
     states_a = np.array(states)
-    out = np.empty((3, 2))
+    out = np.empty((5, 2))
     step_bounds(states_a, taus, out)
     for j in range(len(moves)):
         tau = Fraction(float(taus[j]))
@@ -93,17 +100,35 @@ def test_step_bounds_contain_the_exact_body_velocity(x: float, y: float, a: floa
         with mpmath.workprec(PREC):
             assert mpmath.mpf(out[0, 0]) <= l1 and h1 <= mpmath.mpf(out[0, 1]), (j, l1, h1, out[0])
             assert mpmath.mpf(out[1, 0]) <= l2 and h2 <= mpmath.mpf(out[1, 1]), (j, l2, h2, out[1])
+    m1, m2 = mean_velocity_exact(states_a, taus)  # the odometry increment, at 200 bits
+    with mpmath.workprec(PREC):
+        for lo_hi, m in ((out[3], m1), (out[4], m2)):
+            assert mpmath.mpf(lo_hi[0]) <= m <= mpmath.mpf(lo_hi[1]), (m, lo_hi)
+
+
+def test_the_mean_velocity_stays_tight_when_the_velocity_changes_within_the_step() -> None:
+    """From rest to full speed within one step (inertia): the hull spans [0, 1] m/s, the increment does
+    not widen."""
+    taus = substep_times(0.1, 4)
+    xs = np.cumsum([0.0, 0.0, 0.02, 0.025, 0.025])
+    out = np.empty((5, 2))
+    step_bounds(np.column_stack([xs, np.zeros(5), np.zeros(5)]), taus, out)
+    assert out[0, 1] - out[0, 0] > 0.99  # the hull: from 0 to 1 m/s
+    assert out[3, 0] <= 0.7 <= out[3, 1] and out[3, 1] - out[3, 0] < 1e-14
+    assert out[4, 0] <= 0.0 <= out[4, 1] and out[4, 1] - out[4, 0] < 1e-300  # no sideways motion
 
 
 def test_step_bounds_are_tight_for_straight_motion_and_exact_at_rest() -> None:
     taus = substep_times(0.1, 4)
     straight = np.array([[0.025 * j, 0.0, 0.0] for j in range(5)])
-    out = np.empty((3, 2))
+    out = np.empty((5, 2))
     step_bounds(straight, taus, out)
     assert out[0, 0] <= 1.0 <= out[0, 1] and out[0, 1] - out[0, 0] < 1e-14
     assert out[1].tolist() == [0.0, 0.0] and out[2].tolist() == [0.0, 0.0]
     step_bounds(np.tile([1.0, 2.0, 3.0], (5, 1)), taus, out)
-    assert out.tolist() == [[0.0, 0.0]] * 3
+    assert out.tolist() == [[0.0, 0.0]] * 5
+    with pytest.raises(ValueError, match="out"):
+        step_bounds(straight, taus, np.empty((3, 2)))
 
 
 # --- the premise guard against exact geometry --------------------------------------------------------------

@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from fractions import Fraction
 
+import mpmath
 import numpy as np
 import pytest
 from ground_truth import assert_free
@@ -516,9 +517,7 @@ def test_observe_matches_its_pieces() -> None:
         win = (3, n - 5, 2, n // 2)
         ref = sets_and_map(sure, maybe, free, reach, explored, clear, dark, ref_base, win)
         snap = np.empty((3, n, n), np.uint8)
-        maps = map_context(
-            (sure, maybe, free), MapPlanes(*planes), base, g.xs, -g.ys, 100.0, int(reach.sum())
-        )
+        maps = map_context((sure, maybe, free), MapPlanes(*planes), base, g.xs, -g.ys, 100.0)
         got = observe(maps, lo, hi, (0.1, 0.3), win, 7, 5, img, state, snap)
         assert np.array_equal(snap[:2], planes[:2]) and np.array_equal(snap[2], free)
         assert got == ref + 5 and np.array_equal(base, ref_base) and np.array_equal(img[:3], ref_base)
@@ -530,7 +529,7 @@ def test_observe_matches_its_pieces() -> None:
         foot[p0:p1, q0:q1] = 255
         assert np.array_equal(img[3], foot) and np.array(pixel_blocks((n, n), m)).shape == (4, m)
         want = [lo[0] / 2, lo[1] / 2, hi[0] / 2, hi[1] / 2, math.cos(0.2), math.sin(0.2), 0.1 / math.pi,
-                math.tanh(max(hi - lo)), 0.07, (ref + 5) / reach.sum(), 1.0]  # fmt: skip
+                math.tanh(max(hi - lo)), 0.07, np.count_nonzero(planes[1]) / (n * n), 1.0]  # fmt: skip
         assert np.array_equal(state, np.array(want, np.float32))
 
 
@@ -613,3 +612,37 @@ def test_predict_with_lateral_slip_encloses_the_motion() -> None:
                 assert mpmath.mpf(x0) <= end[0] <= mpmath.mpf(x1), (lo, hi, dt)
                 assert mpmath.mpf(y0) <= end[1] <= mpmath.mpf(y1), (lo, hi, dt)
                 assert mpmath.mpf(hl) <= e <= mpmath.mpf(hh)
+
+
+def test_the_odometry_increment_bounds_the_step_exactly_and_tightly() -> None:
+    """A robot that turns at 1 rad/s while it speeds up from rest (a speed hull of [0, 1] m/s): the hull
+    model alone gives a displacement about 0.1 m wide; the increment ``mean_velocity`` (the displacement in
+    the start frame, per second) keeps it within the heading's and the noise's widths, and the exact
+    displacement (mpmath) stays inside. A contradicting increment empties the box."""
+    from digslam.observer.online.dig_jit import PoseBox
+
+    rng = np.random.default_rng(31)
+    for _ in range(300):
+        th0, dt = rng.uniform(-20, 20), rng.choice([0.1, 0.05, 1e-3])
+        f, lat = rng.uniform(0.0, 1.4), rng.uniform(-0.4, 0.4)  # the body-frame velocity, held over the step
+        dx = dt * (math.cos(th0) * f - math.sin(th0) * lat)  # the end (floats: the truth by definition)
+        dy = dt * (math.sin(th0) * f + math.cos(th0) * lat)
+        prior = PoseBox(-1e-3, -1e-3, 1e-3, 1e-3, th0 - 1e-3, th0 + 1e-3)
+        with mpmath.workprec(200):
+            c, s = mpmath.cos(mpmath.mpf(th0)), mpmath.sin(mpmath.mpf(th0))
+            m = [(c * dx + s * dy) / mpmath.mpf(dt), (c * dy - s * dx) / mpmath.mpf(dt)]
+        noise = 1e-3
+        mv = np.array([[float(v) - noise, float(v) + noise] for v in m])
+        step = _step(dt, (-1.0, 1.0), (th0 - 2.0, th0 + 2.0), (-0.01, 1.5), lateral=(-0.5, 0.5))
+        ok, wide, _ = predict(prior, step)
+        ok2, box, d = predict(prior, step._replace(mean_velocity=mv))
+        assert ok and ok2
+        # the truth: the start is the prior's centre (0, 0) at heading th0, the end is (dx, dy)
+        assert box.x_lo <= dx <= box.x_hi and box.y_lo <= dy <= box.y_hi
+        assert box.x_hi - box.x_lo <= wide.x_hi - wide.x_lo and box.y_hi - box.y_lo <= wide.y_hi - wide.y_lo
+        # the widths: the prior's, the noise's and the heading's (natural interval form of R([psi]) [v])
+        assert box.x_hi - box.x_lo < 2e-3 + 2.01 * noise * dt * 1.42 + 2.01e-3 * (f + abs(lat)) * dt + 1e-12
+        far = mv + 1.0  # an increment 1 m/s off: outside the hull model's displacement
+        ok3, _, _ = predict(prior, step._replace(mean_velocity=far * 10))
+        assert not ok3
+    assert _step(0.1, (0, 0), (0, 0), (0, 0)).mean_velocity.tolist() == [[-math.inf, math.inf]] * 2

@@ -190,3 +190,34 @@ def test_unicycle_record_gives_the_unicycle_velocity_bit_for_bit():
     new = odometry_velocity(rec, h)
     old = unicycle_velocity(rec.speed[1:, 0], rec.speed[1:, 1], h.slice_lo[:, 0], h.slice_hi[:, 0])
     assert all(a.tobytes() == b.tobytes() for a, b in zip(new, old, strict=True))
+
+
+def test_the_odometry_increment_keeps_the_offline_tube_narrow_under_pymunk() -> None:
+    """A pymunk episode (inertia: wide speed hulls): the offline tube with the record's odometry increment
+    holds the true pose and is far narrower than with the hulls alone; a contradicting increment is
+    reported as an inconsistency."""
+    from digslam.envs import ExploreEnv
+    from digslam.envs.explore.episode import record_episode
+    from digslam.observer.slam.digslam import DigSlamConfig, odometry_increment
+    from digslam.observer.slam.grid import Grid
+    from digslam.observer.slam.record import MissionRecord
+
+    rng = np.random.default_rng(3)
+    env = ExploreEnv(world="rocks")
+    ep = record_episode(env, 5, np.column_stack([rng.uniform(0.2, 1.0, 80), rng.uniform(-1, 1, 80)]))
+    rec, truth = ep.records, ep.truth
+    grid = Grid(env.world.frame[:2], env.world.frame[2:], (80, 80))
+    p0 = truth.pose[0, :2]
+    cfg = DigSlamConfig(explored=False)
+    res = dig_slam(rec, grid, p0, p0, cfg)
+    hulls = dig_slam(MissionRecord(**{**rec.as_dict(), "mean_velocity": None}), grid, p0, p0, cfg)
+    assert res.consistent and hulls.consistent
+    for tube in (res.tube, hulls.tube):
+        assert np.all((tube.gate_lo <= truth.pose[:, :2]) & (truth.pose[:, :2] <= tube.gate_hi))
+    assert res.tube.widths().max() < 0.05 < 0.5 < hulls.tube.widths().max()
+    assert odometry_increment(MissionRecord(**{**rec.as_dict(), "mean_velocity": None}), res.heading) is None
+    bad = rec.as_dict()
+    bad["mean_velocity"] = bad["mean_velocity"].copy()
+    bad["mean_velocity"][40] += 5.0  # 5 m/s off: outside the speed hull's reach
+    off = dig_slam(MissionRecord(**bad), grid, p0, p0, cfg)
+    assert not off.consistent and off.first_empty is not None and off.first_empty <= 41

@@ -1,0 +1,107 @@
+"""The navigating baselines' loop closure: how a closure ends, and full episodes on every world generator."""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium import spaces
+
+import digslam.envs  # noqa: F401  (registers the env ids)
+from digslam.agents.baselines.registry import BASELINES, UncertaintyAwareFrontier, make_baseline
+from digslam.envs.sim.generators import GENERATORS
+
+BOX = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
+
+
+def _obs(clear: np.ndarray, dark: np.ndarray, pos: tuple[float, float], tube: float) -> dict[str, np.ndarray]:
+    """An observation with the clear and dark masks (the rest penumbra), the robot at pixel ``pos``."""
+    m = clear.shape[0]
+    img = np.zeros((4, m, m), np.uint8)
+    img[0][clear], img[2][dark & ~clear], img[1][~clear & ~dark] = 255, 255, 255
+    ux, uy = 2 * pos[1] / m - 1, 1 - 2 * pos[0] / m
+    s = np.zeros(11, np.float32)
+    s[:4] = ux, uy, ux, uy
+    s[4], s[7], s[8], s[10] = 1.0, math.tanh(tube), 0.1, 1.0
+    return {"map": img, "state": s}
+
+
+def test_a_closure_with_no_target_left_ends_at_once_even_through_the_cautious_pass() -> None:
+    """The crash of issue #18 on ``rooms``: a closure whose targets are all used up, on a map where no frontier
+    is left over clear ground either, so that the cautious pass (across penumbra) plans a second time."""
+    clear = np.zeros((36, 36), bool)
+    clear[4:32, 4:32] = True
+    pen = np.zeros_like(clear)
+    pen[2:34, 2:34] = True
+    dark = ~pen  # sensed obstacles (penumbra) all around the clear room, dark beyond
+    agent = UncertaintyAwareFrontier(BOX, tube_high=0.5, span=36.0)
+    agent.predict(_obs(clear, dark, (18.5, 18.5), tube=0.05))
+    mem = agent._mem[0]
+    mem.visited[:] = True  # nothing left to explore over clear ground: the cautious pass runs
+    mem.extra.update(closing=0.8, t0=mem.t, done_at=[np.array([18.5, 18.5])], high=0.5, closures=1)
+    mem.best_tube[:] = np.inf  # no obstacle was passed with a narrow tube: no loop-closure target anywhere
+    mem.goal = mem.waypoint = None
+    action, _ = agent.predict(_obs(clear, dark, (18.5, 18.5), tube=0.8))
+    assert BOX.contains(action)
+    assert mem.extra["closing"] is None  # the closure ended: it had nowhere to go
+    assert mem.extra["high"] == pytest.approx(0.8 * agent.backoff)  # a failed one: the tube did not shrink
+    assert all(p is not None for p in mem.extra["done_at"])
+
+
+def test_a_closure_keeps_going_while_targets_remain() -> None:
+    clear = np.zeros((36, 36), bool)
+    clear[2:34, 2:34] = True
+    dark = np.zeros_like(clear)
+    dark[:, 34:] = True
+    agent = UncertaintyAwareFrontier(BOX, tube_high=0.5, span=36.0, visits=3)
+    agent.predict(_obs(clear, dark, (4.5, 4.5), tube=0.05))  # near the top-left walls, narrow tube
+    agent.predict(_obs(clear, dark, (4.5, 29.5), tube=0.05))  # near the top-right ones, 25 m away
+    agent.predict(_obs(clear, dark, (20.5, 20.5), tube=0.8))
+    mem = agent._mem[0]
+    assert mem.extra["closing"] == pytest.approx(0.8, abs=1e-6) and mem.extra["targets"]
+    first = mem.goal
+    agent.predict(_obs(clear, dark, (first[0] + 0.5, first[1] + 0.5), tube=0.8))  # at the target: one visit
+    assert len(mem.extra["done_at"]) == 1 and mem.extra["closing"] is not None  # the other corner is left
+    assert mem.goal is not None and abs(mem.goal[1] - first[1]) > 15
+    second = mem.goal
+    agent.predict(_obs(clear, dark, (second[0] + 0.5, second[1] + 0.5), tube=0.8))
+    assert len(mem.extra["done_at"]) == 2 and mem.extra["closing"] is None  # no target left: it ended
+    assert mem.extra["high"] == pytest.approx(0.8 * agent.backoff)
+
+
+@pytest.mark.parametrize("world", sorted(set(GENERATORS) - {"file"}))
+@pytest.mark.parametrize("name", ["frontier", "uncertainty_frontier"])
+def test_the_frontier_agents_run_a_full_short_episode_on_every_generator(world: str, name: str) -> None:
+    env = gym.make("digslam/DigCoverage-v0", world=world, map_size=36, max_episode_steps=150)
+    agent = make_baseline(name, env, seed=0)
+    assert name in BASELINES
+    obs, info = env.reset(seed=1)
+    done, steps = False, 0
+    while not done:
+        action, _ = agent.predict(obs)
+        assert env.action_space.contains(action)
+        obs, _, terminated, truncated, info = env.step(action)
+        done, steps = terminated or truncated, steps + 1
+    assert steps <= 150 and info["consistent"] and info["certified_coverage"] > 0.0
+    env.close()
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_uncertainty_aware_frontier_survives_the_rooms_episode_that_crashed(seed: int) -> None:
+    """On ``rooms`` the closures run out of targets (``TypeError`` in ``_costs`` before the fix, after about
+    2300 steps with the defaults); here within 500 steps: a low threshold starts closures early and a wide
+    spread uses their targets up fast (the old code crashed on three of these four maps)."""
+    env = gym.make("digslam/DigCoverage-v0", world="rooms", map_size=36, max_episode_steps=500)
+    agent = make_baseline("uncertainty_frontier", env, seed=0)
+    agent.tube_high, agent.closure_steps, agent.spread = 0.05, 100, 8.0
+    obs, _ = env.reset(seed=seed)
+    done = False
+    while not done:
+        obs, _, terminated, truncated, info = env.step(agent.predict(obs)[0])
+        done = terminated or truncated
+    extra = agent._mem[0].extra
+    assert extra.get("exhausted", 0) >= 1  # the path that crashed was taken
+    assert info["consistent"]
+    env.close()
