@@ -265,23 +265,6 @@ def _edge_cone(edge: _Edge, px: np.ndarray, py: np.ndarray, pn: np.ndarray, pe: 
     return lo, hi
 
 
-@njit(inline="always")
-def _bound_cones(edge: _Edge, px: np.ndarray, py: np.ndarray, pn: np.ndarray, pe: np.ndarray, near: float,
-                 back: np.ndarray, lo: np.ndarray, hi: np.ndarray, ux: np.ndarray, uy: np.ndarray,
-                 cg: np.ndarray, w: np.ndarray, e_u: np.ndarray, e_w: np.ndarray, sh: np.ndarray,
-                 whole: np.ndarray) -> None:  # fmt: skip
-    """Lower ``lo``, ``hi`` (per cone) by the bounds of :func:`_edge_cone` for one edge, skipping the cones
-    with no apex shift (``back`` not finite) and those the edge cannot improve (``near``: no apex is nearer
-    to any point of it)."""
-    for s in range(lo.shape[0]):
-        if not math.isfinite(back[s]) or (near >= lo[s] and near >= hi[s]):
-            continue
-        cone = _ConeBounds(ux[s], uy[s], cg[s], w[s, 0], w[s, 1], w[s, 2], w[s, 3], e_u[s], e_w[s, 0],
-                           e_w[s, 1], sh[s], whole[s])  # fmt: skip
-        d_lo, d_hi = _edge_cone(edge, px, py, pn, pe, cone)
-        lo[s], hi[s] = min(lo[s], d_lo), min(hi[s], d_hi)
-
-
 @njit
 def sector_bounds_kernel(x: float, y: float, th: float, alpha: np.ndarray, gamma: np.ndarray,
                          edges: np.ndarray, bbox: np.ndarray, reach: float, perr: float,
@@ -361,7 +344,13 @@ def sector_bounds_kernel(x: float, y: float, th: float, alpha: np.ndarray, gamma
             seg = min(seg, pn[j] - pe[j])
         near = seg - shift_max * (1.0 + 16.0 * _U)  # no apex is nearer to any point of the edge
         edge = _Edge(ax, ay, dx, dy, npts, seg, e_pt)
-        _bound_cones(edge, px, py, pn, pe, near, back, lo, hi, ux, uy, cg, w, e_u, e_w, sh, whole)
+        for s in range(S):
+            if not math.isfinite(back[s]) or (near >= lo[s] and near >= hi[s]):
+                continue
+            cone = _ConeBounds(ux[s], uy[s], cg[s], w[s, 0], w[s, 1], w[s, 2], w[s, 3], e_u[s], e_w[s, 0],
+                               e_w[s, 1], sh[s], whole[s])  # fmt: skip
+            d_lo, d_hi = _edge_cone(edge, px, py, pn, pe, cone)
+            lo[s], hi[s] = min(lo[s], d_lo), min(hi[s], d_hi)
     cap = reach * (1.0 - 16.0 * _U) - 1.5 * perr - 4.0 * _U * mag
     for s in range(S):
         if not math.isfinite(back[s]):
@@ -481,7 +470,13 @@ def sense_kernel(pose: np.ndarray, cones: np.ndarray, edges: np.ndarray, bbox: n
             seg = min(seg, pn[j] - pe[j])
         near = seg - shift_max * (1.0 + 16.0 * _U)
         edge = _Edge(ax, ay, dx, dy, npts, seg, e_pt)
-        _bound_cones(edge, px, py, pn, pe, near, back, lo, hi, ux, uy, cg, w, e_u, e_w, sh, whole)
+        for s in range(S):
+            if not math.isfinite(back[s]) or (near >= lo[s] and near >= hi[s]):
+                continue
+            cone = _ConeBounds(ux[s], uy[s], cg[s], w[s, 0], w[s, 1], w[s, 2], w[s, 3], e_u[s], e_w[s, 0],
+                               e_w[s, 1], sh[s], whole[s])  # fmt: skip
+            d_lo, d_hi = _edge_cone(edge, px, py, pn, pe, cone)
+            lo[s], hi[s] = min(lo[s], d_lo), min(hi[s], d_hi)
     cap = reach_b * (1.0 - 16.0 * _U) - 1.5 * perr - 4.0 * _U * mag
     for s in range(S):
         if not dist[s] <= cones[2, s]:
