@@ -162,8 +162,19 @@ class BaselinePolicy:
         return self.span / m
 
     def _disk(self, m: int, centre: np.ndarray, radius_px: float) -> np.ndarray:
-        rr, cc = np.ogrid[:m, :m]
-        return (rr + 0.5 - centre[0]) ** 2 + (cc + 0.5 - centre[1]) ** 2 <= radius_px**2
+        """``(m, m)`` bool: the pixels whose centre lies within ``radius_px`` of ``centre`` (row, column),
+        computed on the disc's bounding window only."""
+        out = np.zeros((m, m), dtype=bool)
+        r2 = radius_px**2
+        (r0, r1), (c0, c1) = (
+            (max(int(math.floor(c - radius_px)) - 1, 0), min(int(math.ceil(c + radius_px)) + 1, m))
+            for c in (float(centre[0]), float(centre[1]))
+        )
+        if r0 < r1 and c0 < c1:
+            rr = np.arange(r0, r1)[:, None]
+            cc = np.arange(c0, c1)[None, :]
+            out[r0:r1, c0:c1] = (rr + 0.5 - centre[0]) ** 2 + (cc + 0.5 - centre[1]) ** 2 <= r2
+        return out
 
     def _drive(self, view: View, mem: Memory) -> np.ndarray:
         """Turn-then-go towards ``mem.waypoint``; clears it when reached."""

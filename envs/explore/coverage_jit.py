@@ -14,6 +14,18 @@ cells, and skips the blocks with none left or none within reach, and the whole s
 within reach. Same decisions, bit for bit, as the kernel without block skipping it replaced (the oracle
 ``tests/coverage_oracle.py``), and as the numpy brute force of ``tests/envs/explore/test_coverage.py``
 except for cell centres within rounding of a cone edge.
+
+Example (one omnidirectional sensor of reach 0.12 at the centre of a 3 x 3 grid of 0.1 m cells; a second
+update from the same pose finds nothing new):
+    >>> todo, seen = np.ones((3, 3), dtype=bool), np.zeros((3, 3), dtype=bool)
+    >>> xs = ys = np.array([0.05, 0.15, 0.25])
+    >>> geo = np.concatenate([[0.0, 0.0, 0.1, 0.1, 2, 2], xs, ys])   # corner, cell sides, reach in cells
+    >>> cones = cone_table(np.array([0.0]), np.ones((1, 1), dtype=bool), np.array([0.12]))
+    >>> pose, ranges, blocks = np.array([0.15, 0.15, 0.0]), np.array([np.inf]), todo_blocks(todo)
+    >>> cover_step(todo, blocks, seen, geo, pose, cones, ranges), seen.astype(int).tolist()
+    (5, [[0, 1, 0], [1, 1, 1], [0, 1, 0]])
+    >>> cover_step(todo, blocks, seen, geo, pose, cones, ranges)
+    0
 """
 
 from __future__ import annotations

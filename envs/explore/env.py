@@ -54,6 +54,9 @@ from digslam.envs.sim.sensors import SensorSuite, record_step
 from digslam.envs.sim.world import World
 from digslam.observer.slam.record import MissionRecord
 
+#: The largest ``|a_i|`` of an action (normalised ``v``, ``omega``) accepted, then clipped to ``[-1, 1]``.
+_ACTION_TOL = 1.0 + 1e-6
+
 
 def _generator(cfg: ExploreConfig) -> WorldGenerator:
     if cfg.world == "file":
@@ -169,10 +172,10 @@ class ExploreEnv(gym.Env):
         (the internal fast path of the observer wrapper, which hands the agent its own observation)."""
         if self.sim is None:
             raise RuntimeError("step: call reset() before step()")
-        a = self._check_action(action)
+        v, w = self._check_action(action)
         cfg = self.config
         t1 = self.t + cfg.dt
-        bumps = self.sim.step(a[0] * cfg.max_speed, a[1] * cfg.max_yaw_rate, exact_duration(self.t, t1),
+        bumps = self.sim.step(v * cfg.max_speed, w * cfg.max_yaw_rate, exact_duration(self.t, t1),
                               cfg.substeps)  # fmt: skip
         self.t = t1
         record, truth = self._sense(bumps)
@@ -215,29 +218,32 @@ class ExploreEnv(gym.Env):
         a = np.asarray(action)
         if a.shape != (2,):
             raise ValueError(f"action: expected shape (2,), got {a.shape}")
-        v, w = float(a[0]), float(a[1])
-        if not (math.isfinite(v) and math.isfinite(w)):
-            raise ValueError(f"action: must be finite, got {[v, w]}")
-        if abs(v) > 1.0 + 1e-6 or abs(w) > 1.0 + 1e-6:
+        v, w = a.tolist()
+        v, w = float(v), float(w)
+        if not (abs(v) <= _ACTION_TOL and abs(w) <= _ACTION_TOL):  # (false for NaN)
+            if not (math.isfinite(v) and math.isfinite(w)):
+                raise ValueError(f"action: must be finite, got {[v, w]}")
             raise ValueError(f"action: must lie in [-1, 1]^2 (normalised v, omega), got {[v, w]}")
         return min(max(v, -1.0), 1.0), min(max(w, -1.0), 1.0)
 
     def _sense(self, bumps: int) -> tuple[MissionRecord, GroundTruth]:
         assert self.sim is not None and self.world is not None
-        sim = self.sim
+        sim, suite = self.sim, self.suite
         pose = sim.pose
-        ranges, bounds = self.suite.sense(self.world, pose, sim.pose_error)  # true_ranges, range_bounds
-        pymunk = sim.dynamics == "pymunk"
-        record = record_step(self.t, self.suite, bounds, sim.hulls, pose[2], sim.measured, self.config.noise,
+        ranges, bounds = suite.sense(self.world, pose, sim.pose_error)  # true_ranges, range_bounds
+        record = record_step(self.t, suite, bounds, sim.hulls, pose[2], sim.measured, self.config.noise,
                              self.np_random)  # fmt: skip
-        states = taus = None
-        if pymunk:
+        if sim.dynamics == "pymunk":
             states, taus = sim.states, sim.taus  # fresh arrays each step (the durations shared, read-only)
             if not len(taus):  # at reset: at rest, S + 1 copies of the start pose
                 n = self.config.substeps
                 states, taus = np.repeat(pose[None], n + 1, axis=0), np.zeros(n)
-        truth = GroundTruth.of_step(self.t, pose, sim.speed, sim.yaw_rate, ranges, bumps, sim.bumps,
-                                    sim.pieces.copy(), sim.pose_error, sim.lateral, states, taus)  # fmt: skip
+            pieces = sim.pieces  # NaN: shared, read-only
+        else:
+            states = taus = None
+            pieces = sim.pieces.copy()  # the simulator rewrites its pieces each step
+        truth = GroundTruth.of_step(self.t, pose, sim.speed, sim.yaw_rate, ranges, bumps, sim.bumps, pieces,
+                                    sim.pose_error, sim.lateral, states, taus)  # fmt: skip
         return record, truth
 
     def _reward(self, truth: GroundTruth) -> float:
@@ -260,9 +266,11 @@ class ExploreEnv(gym.Env):
     def _obs(self, record: MissionRecord) -> dict[str, np.ndarray]:
         # lower range bounds are >= 0 by construction; the heading is shifted by a multiple of 2 pi
         lo, hi = self._heading_box
-        ranges, no_echo, odo, heading = obs_kernel(record.range, record.no_echo, record.speed, record.lateral,
-                                                   record.yaw_rate, record.heading, self._top,
-                                                   self._odo_tops[0], self._odo_tops[1], lo, hi)  # fmt: skip
+        n = self.suite.n
+        ranges, no_echo, odo, heading = np.empty((n, 2)), np.empty(n, np.int8), np.empty((3, 2)), np.empty(2)
+        obs_kernel(record.range, record.no_echo, record.speed, record.lateral, record.yaw_rate,
+                   record.heading, self._top, self._odo_tops[0], self._odo_tops[1], lo, hi, ranges, no_echo,
+                   odo, heading)  # fmt: skip
         return {"ranges": ranges, "no_echo": no_echo, "odometry": odo, "heading": heading}
 
 

@@ -83,10 +83,11 @@ class GroundTruth:
         f = np.array([t, speed, yaw_rate, pose_error, lateral], dtype=np.float64)
         i = np.array([bumps, bumps_total], dtype=np.int64)
         g = cls.__new__(cls)
-        g.__dict__.update(t=f[..., 0], pose=pose, speed=f[..., 1], yaw_rate=f[..., 2], ranges=ranges,
-                          bumps=i[..., 0], bumps_total=i[..., 1], pieces=pieces, pose_error=f[..., 3],
-                          lateral=f[..., 4], states=_EMPTY_STATES if states is None else states,
-                          taus=_EMPTY_TAUS if taus is None else taus)  # fmt: skip
+        g.__dict__ = {"t": f[..., 0], "pose": pose, "speed": f[..., 1], "yaw_rate": f[..., 2],
+                      "ranges": ranges, "bumps": i[..., 0], "bumps_total": i[..., 1], "pieces": pieces,
+                      "pose_error": f[..., 3], "lateral": f[..., 4],
+                      "states": _EMPTY_STATES if states is None else states,
+                      "taus": _EMPTY_TAUS if taus is None else taus}  # fmt: skip
         return g
 
     def as_dict(self) -> dict[str, np.ndarray]:

@@ -300,9 +300,20 @@ def step_bounds(states: np.ndarray, taus: np.ndarray, out: np.ndarray) -> None:
     out[3, 0], out[3, 1], out[4, 0], out[4, 1] = m1l, m1h, m2l, m2h
 
 
+@njit
+def step_bounds_free(states: np.ndarray, taus: np.ndarray, out: np.ndarray, radius: float, reach: float,
+                     edges: np.ndarray, bbox: np.ndarray) -> float:  # fmt: skip
+    """:func:`step_bounds` into ``out``, then :func:`free_radius` around the step's end ``states[-1]``: the
+    simulator's one compiled call after a step, which leaves the next step's fast path ready."""
+    step_bounds(states, taus, out)
+    n = states.shape[0] - 1
+    return free_radius(states[n, 0], states[n, 1], radius, reach, edges, bbox)
+
+
 __all__ = [
     "free_radius",
     "step_bounds",
+    "step_bounds_free",
     "substep_clear",
     "substep_times",
 ]

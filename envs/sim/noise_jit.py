@@ -1,6 +1,7 @@
 """Compiled kernels of the bounded noise (:mod:`.noise`) and of the step's record (:mod:`.sensors`).
 
-The random draws stay in numpy (``rng.uniform``, in the same order as before, so runs are reproducible);
+The random draws stay in numpy (``rng.uniform``, or ``rng.random`` mapped to the same values, in the same
+order as before, so runs are reproducible);
 the kernels turn them into measured values and intervals. Every interval contains the truth exactly:
 
 * ``uniform`` / ``biased``: ``[m - b, m + b]`` widened by 4 ulps of ``max(|m|, b)``;
@@ -96,11 +97,17 @@ class RecordModel(NamedTuple):
     range: float
     tol: float
 
+    def scalars(self) -> np.ndarray:
+        """The fields after ``r_max`` as one float64 array ``(7,)``, in order: what :func:`record_kernel`
+        reads (one array argument costs numba's dispatch far less than the tuple)."""
+        fields = (self.model, self.bias, self.speed, self.yaw_rate, self.heading, self.range, self.tol)
+        return np.array(fields, dtype=np.float64)
+
 
 @njit
-def record_kernel(r_b: np.ndarray, hulls: np.ndarray, heading: float, measured: int, noise: RecordModel,
-                  u: np.ndarray, outlier: np.ndarray, outlier_lo: np.ndarray, outlier_hi: np.ndarray,
-                  out: np.ndarray, no_echo: np.ndarray) -> int:  # fmt: skip
+def record_kernel(r_b: np.ndarray, hulls: np.ndarray, heading: float, measured: int, r_max: np.ndarray,
+                  noise: np.ndarray, u: np.ndarray, outlier: np.ndarray, outlier_lo: np.ndarray,
+                  outlier_hi: np.ndarray, out: np.ndarray, no_echo: np.ndarray) -> int:  # fmt: skip
     """Intervals of one step into ``out (n + 6, 2)`` (speed, yaw rate, heading, the ``n`` ranges, then the
     lateral velocity and the two components of the odometry increment); ``no_echo``.
 
@@ -109,56 +116,58 @@ def record_kernel(r_b: np.ndarray, hulls: np.ndarray, heading: float, measured: 
     velocity, leftward velocity and yaw rate and the bounds of the odometry increment's two components (rows
     :data:`SPEED`, :data:`LATERAL`, :data:`YAW`, :data:`MEAN1`, :data:`MEAN2`, as
     :func:`.dynamics_jit.step_bounds` writes them), the true ``heading``, and ``measured``, the bits
-    :data:`MEASURE_LATERAL` (a Doppler velocity log, with the speed's noise bound; unmeasured, the lateral
-    row is known to be the hull, ``[0, 0]`` for a unicycle, and is recorded as it is) and
-    :data:`MEASURE_MEAN` (unmeasured: ``[-inf, inf]`` twice). ``noise`` holds the maximum ranges, the noise
-    model and its bounds (:class:`RecordModel`); ``u`` the step's uniform draws in ``[-1, 1)``: ``n + 3``
-    (speed, yaw rate, heading, then the ranges), plus one for the lateral velocity when it is measured (so a
-    unicycle draws exactly what it drew before the lateral velocity existed), plus two for the increment
-    when it is measured; ``outlier`` (bool) the range readings replaced by an outlier, whose intervals are
-    ``[outlier_lo, outlier_hi]``. A hull ``[lo, hi]`` is reported as the noisy interval of its midpoint
-    widened by its half-width, so it contains the whole hull (under ``adversarial`` noise the hull touches a
-    bound). A reading is ``no_echo`` (``[r_max, inf]``) only when the lower bound exceeds ``r_max``; one
-    whose upper bound is not finite reads ``[min(lo, r_max), inf]``. Every finite bound is widened by
-    ``noise.tol``. Returns the first row whose interval has a NaN or ``lo > hi`` (the checks of
+    :data:`MEASURE_LATERAL` (a Doppler velocity log, with the speed's noise bound; unmeasured, the lateral row
+    is known to be the hull, ``[0, 0]`` for a unicycle, and is recorded as it is) and :data:`MEASURE_MEAN`
+    (unmeasured: ``[-inf, inf]`` twice). ``r_max`` holds the maximum ranges, ``noise`` the noise model and its
+    bounds (:meth:`RecordModel.scalars` of the :class:`RecordModel`); ``u`` the step's draws of
+    ``Generator.random`` in ``[0, 1)``, each read as ``-1 + 2 u`` in ``[-1, 1)`` (bit for bit what
+    ``Generator.uniform(-1, 1)`` returns for the same state: ``2 u`` is exact, so both round the same real sum
+    once): ``n + 3`` (speed, yaw rate, heading, then the ranges), plus one for the lateral velocity when it is
+    measured (so a unicycle draws exactly what it drew before the lateral velocity existed), plus two for the
+    increment when it is measured; ``outlier`` (bool) the range readings replaced by an outlier, whose
+    intervals are ``[outlier_lo, outlier_hi]``. A hull ``[lo, hi]`` is reported as the noisy interval of its
+    midpoint widened by its half-width, so it contains the whole hull (under ``adversarial`` noise the hull
+    touches a bound). A reading is ``no_echo`` (``[r_max, inf]``) only when the lower bound exceeds ``r_max``;
+    one whose upper bound is not finite reads ``[min(lo, r_max), inf]``. Every finite bound is widened by the
+    model's ``tol``. Returns the first row whose interval has a NaN or ``lo > hi`` (the checks of
     :class:`~digslam.observer.slam.record.MissionRecord`), -1 if none.
     """
-    r_max = noise.r_max
-    model, bias, b_range, tol = noise.model, noise.bias, noise.range, noise.tol
+    model, bias, b_speed, b_yaw, b_heading, b_range, tol = (int(noise[0]), noise[1], noise[2], noise[3],
+                                                            noise[4], noise[5], noise[6])  # fmt: skip
     flag, o_lo, o_hi = outlier, outlier_lo, outlier_hi
     n = r_b.shape[0]
     lat = n + 3
     lateral, mean = (measured & MEASURE_LATERAL) != 0, (measured & MEASURE_MEAN) != 0
     for k in range(5):
         if k == 0:
-            src, b, row, draw = SPEED, noise.speed, 0, 0
+            src, b, row, draw = SPEED, b_speed, 0, 0
         elif k == 1:
-            src, b, row, draw = YAW, noise.yaw_rate, 1, 1
+            src, b, row, draw = YAW, b_yaw, 1, 1
         elif k == 2:
-            src, b, row, draw = LATERAL, noise.speed, lat, lat
+            src, b, row, draw = LATERAL, b_speed, lat, lat
             if not lateral:
                 out[lat, 0], out[lat, 1] = hulls[LATERAL, 0], hulls[LATERAL, 1]
                 continue
         else:
             row = lat + k - 2
-            src, b, draw = MEAN1 + k - 3, noise.speed, row if lateral else row - 1
+            src, b, draw = MEAN1 + k - 3, b_speed, row if lateral else row - 1
             if not mean:
                 out[row, 0], out[row, 1] = -math.inf, math.inf
                 continue
         h_lo, h_hi = hulls[src, 0], hulls[src, 1]
         half = 0.5 * (h_hi - h_lo)
-        _, lo, hi = _one(0.5 * (h_lo + h_hi), b, u[draw], model, bias)
+        _, lo, hi = _one(0.5 * (h_lo + h_hi), b, -1.0 + 2.0 * u[draw], model, bias)
         out[row, 0], out[row, 1] = min(lo - half, h_lo), max(hi + half, h_hi)  # exact containment of the hull
-    _, out[2, 0], out[2, 1] = _one(heading, noise.heading, u[2], model, bias)
+    _, out[2, 0], out[2, 1] = _one(heading, b_heading, -1.0 + 2.0 * u[2], model, bias)
     for s in range(n):
         a, z = r_b[s, 0], r_b[s, 1]
         no_echo[s] = not a <= r_max[s]
         if no_echo[s] or not math.isfinite(z):
-            _, lo, hi = _one(0.0 if no_echo[s] else a, b_range, u[3 + s], model, bias)
+            _, lo, hi = _one(0.0 if no_echo[s] else a, b_range, -1.0 + 2.0 * u[3 + s], model, bias)
             lo, hi = min(lo, r_max[s]), math.inf
         else:
             half = 0.5 * (z - a)
-            _, lo, hi = _one(0.5 * (a + z), b_range, u[3 + s], model, bias)
+            _, lo, hi = _one(0.5 * (a + z), b_range, -1.0 + 2.0 * u[3 + s], model, bias)
             lo, hi = min(lo - half, a), max(hi + half, z)
         if flag[s]:
             out[3 + s, 0], out[3 + s, 1] = o_lo[s], o_hi[s]
@@ -178,27 +187,24 @@ def record_kernel(r_b: np.ndarray, hulls: np.ndarray, heading: float, measured: 
 
 @njit
 def obs_kernel(rng: np.ndarray, no_echo: np.ndarray, speed: np.ndarray, lateral: np.ndarray, yaw: np.ndarray,
-               heading: np.ndarray, top: float, s_top: float, w_top: float, h_lo: float,
-               h_hi: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
-    """The observation of a record: ranges capped at ``top``, ``no_echo`` as int8, the odometry ``(3, 2)``
-    (speed, lateral velocity, yaw rate) clipped to ``±s_top``, ``±s_top`` and ``±w_top``, and the heading
-    shifted by the multiple of ``2 pi`` nearest its
-    midpoint (half to even, as ``np.round``), clipped to ``[h_lo, h_hi]``; all new arrays."""
+               heading: np.ndarray, top: float, s_top: float, w_top: float, h_lo: float, h_hi: float,
+               r: np.ndarray, e: np.ndarray, odo: np.ndarray, h: np.ndarray) -> None:  # fmt: skip
+    """The observation of a record, written into ``r (n, 2)``, ``e (n,)`` (int8), ``odo (3, 2)`` and
+    ``h (2,)`` (new arrays the caller allocates: cheaper than boxing arrays the kernel allocates): ranges
+    capped at ``top``, ``no_echo`` as int8, the odometry (speed, lateral velocity, yaw rate) clipped to
+    ``±s_top``, ``±s_top`` and ``±w_top``, and the heading shifted by the multiple of ``2 pi`` nearest its
+    midpoint (half to even, as ``np.round``), clipped to ``[h_lo, h_hi]``."""
     n = rng.shape[0]
-    r, e = np.empty((n, 2)), np.empty(n, dtype=np.int8)
     for s in range(n):
         r[s, 0], r[s, 1] = min(rng[s, 0], top), min(rng[s, 1], top)
         e[s] = 1 if no_echo[s] else 0
-    odo = np.empty((3, 2))
     for j in range(2):
         odo[0, j] = min(max(speed[j], -s_top), s_top)
         odo[1, j] = min(max(lateral[j], -s_top), s_top)
         odo[2, j] = min(max(yaw[j], -w_top), w_top)
     k = np.rint(0.5 * (heading[0] + heading[1]) / (2 * math.pi)) * 2 * math.pi
-    h = np.empty(2)
     for j in range(2):
         h[j] = min(max(heading[j] - k, h_lo), h_hi)
-    return r, e, odo, h
 
 
 __all__ = [

@@ -18,7 +18,9 @@ them and friction turns it; contacts are pymunk's. (An earlier version drove the
 record: the body's velocity lagged its heading, by up to 0.5 rad on reversals, and slid along walls, motions
 no unicycle with the recorded heading explains. The record's lateral velocity and the rigorous hulls below
 close that gap.) The collision circle has radius ``radius + skin``. A step of ``dt`` seconds runs ``substeps``
-pymunk steps whose durations are exact floats summing exactly to ``dt`` (:func:`.dynamics_jit.substep_times`).
+pymunk steps whose durations are exact floats summing exactly to ``dt`` (:func:`.dynamics_jit.substep_times`);
+while the space has no queued work they call chipmunk's step and body accessors directly (``Space.step``'s
+C call without its Python bookkeeping: the same states, bit for bit).
 The truth is the piecewise-linear path through the states read back after each substep (:mod:`.dynamics_jit`:
 exact by definition, so ``pose_error = 0``); its body-frame velocity and yaw rate are bounded rigorously over
 the step (:func:`.dynamics_jit.step_bounds`), and so is the odometry increment (:attr:`~RobotSim.mean_hull`:
@@ -57,7 +59,7 @@ import pymunk
 
 from digslam.envs.config import DYNAMICS
 from digslam.envs.sim import geometry_jit as gjit
-from digslam.envs.sim.dynamics_jit import free_radius, step_bounds, substep_clear, substep_times
+from digslam.envs.sim.dynamics_jit import free_radius, step_bounds_free, substep_clear, substep_times
 from digslam.envs.sim.noise_jit import MEASURE_LATERAL, MEASURE_MEAN
 from digslam.envs.sim.robot_jit import robot_step_kernel
 from digslam.envs.sim.world import World
@@ -74,9 +76,28 @@ _NAN_PIECES = np.full((2, 3), np.nan)
 _NAN_PIECES.flags.writeable = False
 #: How far (m) the guard's fast path looks around a step's start; ``_GROW`` covers an L1 norm's rounding.
 _FREE_REACH, _GROW = 1.0, 1.0 + 2.0**-50
-# pymunk's property accessors, called directly (skips pymunk's per-instance ``__setattr__`` hook)
-_SET_V, _SET_W = pymunk.Body.velocity.fset, pymunk.Body.angular_velocity.fset
-_GET_P, _GET_A = pymunk.Body.position.fget, pymunk.Body.angle.fget
+# chipmunk's calls behind pymunk's ``Space.step`` and body accessors, made directly in the substep loop (the
+# same C calls on the same values, without pymunk's Python wrappers; see ``RobotSim._step_pymunk``). They are
+# pymunk internals: a pymunk without them (or without the space's queue attributes) takes the public path.
+try:
+    from pymunk._chipmunk import lib as _cp
+
+    _CP_STEP, _CP_SET_V, _CP_SET_W = _cp.cpSpaceStep, _cp.cpBodySetVelocity, _cp.cpBodySetAngularVelocity
+    _CP_GET_P, _CP_GET_A = _cp.cpBodyGetPosition, _cp.cpBodyGetAngle
+    _DIRECT = True
+except (ImportError, AttributeError):  # pragma: no cover - another pymunk
+    _DIRECT = False
+#: The queues ``Space.step`` works through after chipmunk's step (the direct path needs them empty).
+_QUEUES = ("_bodies_to_check", "_add_later", "_remove_later", "_post_step_callbacks", "_removed_shapes")
+
+
+def _quiet(space: pymunk.Space) -> bool | None:
+    """Whether ``space`` has nothing queued for ``Space.step``'s Python bookkeeping (None: a pymunk whose
+    internals differ, so the direct path is off)."""
+    try:
+        return not (space.threaded or any(getattr(space, q) for q in _QUEUES))
+    except AttributeError:  # pragma: no cover - another pymunk
+        return None
 
 
 class RobotSim:
@@ -163,6 +184,12 @@ class RobotSim:
         #: pymunk, whose stored states are the truth).
         self.pose_error = 0.0
         self._times: dict[tuple[float, int], tuple[np.ndarray, list[float]]] = {}
+        #: The guard's fast path around the current pose (pymunk: :func:`.dynamics_jit.free_radius`, then
+        #: computed at the end of each step for the next, :func:`.dynamics_jit.step_bounds_free`).
+        self._free = 0.0
+        if dynamics == "pymunk":
+            x, y = self._pose[0], self._pose[1]
+            self._free = free_radius(x, y, self.radius, _FREE_REACH, self.edges, self.bbox)
 
     def _begin(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
         if self._touching == 0:
@@ -196,19 +223,38 @@ class RobotSim:
             got = self._times[key] = (taus, taus.tolist())
         taus, tau_list = got
         x, y, a = self._pose.tolist()
-        x0, y0, rows = x, y, [(x, y, a)]
-        body, control, step = self.body, self.control, self.space.step
+        x0, y0, flat = x, y, [x, y, a]  # the states, row after row
+        space, body, control = self.space, self.body, self.control
+        # pymunk's Space.step is chipmunk's step plus Python bookkeeping that has nothing to do while the
+        # space's queues are empty (no body added or changed, nothing deferred, no threads): then the substeps
+        # call chipmunk directly, locking the space as Space.step does (the same C calls, the same results);
+        # else they go through Space.step. (The robot's collision callbacks defer nothing.)
+        direct = _DIRECT and bool(_quiet(space))
+        if direct:
+            cp_space, cp_body, cp_control = space._space, body._body, control._body
         radius, edges, bbox = self.radius, self.edges, self.bbox
         # the fast path of the guard: a substep whose ends lie within `free` of the start is clear
-        free = free_radius(x0, y0, radius, _FREE_REACH, edges, bbox)
+        free = self._free
         inside = free > 0.0
         bumps = self.bumps
-        _SET_W(control, omega)
+        if direct:
+            _CP_SET_W(cp_control, omega)
+        else:
+            control.angular_velocity = omega
         for tau in tau_list:
-            _SET_V(control, (v * math.cos(a), v * math.sin(a)))
-            step(tau)
-            x1, y1 = _GET_P(body)
-            a1 = _GET_A(body)
+            if direct:
+                _CP_SET_V(cp_control, (v * math.cos(a), v * math.sin(a)))
+                space._locked = True
+                try:
+                    _CP_STEP(cp_space, tau)
+                finally:
+                    space._locked = False
+                p = _CP_GET_P(cp_body)
+                x1, y1, a1 = p.x, p.y, _CP_GET_A(cp_body)
+            else:  # pymunk's public path
+                control.velocity = (v * math.cos(a), v * math.sin(a))
+                space.step(tau)
+                (x1, y1), a1 = body.position, body.angle
             near = (abs(x1 - x0) + abs(y1 - y0)) * _GROW < free  # |p1 - p0| < free, rounding included
             ok = a1 - a1 == 0.0 and ((inside and near) or substep_clear(x, y, x1, y1, radius, edges, bbox))
             if not ok:  # (a NaN or infinite state is never ok) undo the substep: a hard stop
@@ -217,12 +263,15 @@ class RobotSim:
                 body.position, body.angle = (x, y), a
                 body.velocity, body.angular_velocity = (0.0, 0.0), 0.0
             x, y, a, inside = x1, y1, a1, near
-            rows.append((x, y, a))
-        states = np.array(rows)
+            flat += x, y, a
+        if direct and (space._add_later or space._remove_later or space._post_step_callbacks):
+            raise RuntimeError("step: a collision callback deferred work on the robot's space")
+        states = np.array(flat).reshape(-1, 3)
         self._pose[0], self._pose[1], self._pose[2] = x, y, a
-        step_bounds(states, taus, self.hulls)
+        # the hulls, and the next step's fast path around the end pose
+        self._free = step_bounds_free(states, taus, self.hulls, radius, _FREE_REACH, edges, bbox)
         # the true velocity at the step's end (floats): the last substep's, in the body frame at angle a_S
-        tau, (xp, yp, ap) = tau_list[-1], rows[-2]
+        tau, (xp, yp, ap) = tau_list[-1], flat[-6:-3]
         ux, uy = (x - xp) / tau, (y - yp) / tau
         c, s = math.cos(a), math.sin(a)
         self._v, self._lat, self._w = c * ux + s * uy, c * uy - s * ux, (a - ap) / tau

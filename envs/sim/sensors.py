@@ -73,7 +73,9 @@ class SensorSuite:
         for name in ("alpha", "gamma", "r_max"):
             object.__setattr__(self, "_k_" + name, getattr(self, name).copy())
         object.__setattr__(self, "_k_cones", np.stack([self.alpha, self.gamma, self.r_max]))  # sense()
-        object.__setattr__(self, "_model", (None, None, None))  # (noise, tol, its RecordModel): measure_step
+        # record_step's cache per noise configuration: (noise, tol, r_max, the RecordModel's scalars, whether
+        # outliers are drawn)
+        object.__setattr__(self, "_model", (None, None, None, None, False))
 
     @classmethod
     def from_config(cls, cfg: ExploreConfig) -> SensorSuite:
@@ -174,19 +176,21 @@ def record_step(t: float, suite: SensorSuite, ranges: np.ndarray, hulls: np.ndar
         elif r.shape != (n, 2):
             raise ValueError(f"ranges: expected shape ({n},) or ({n}, 2), got {r.shape}")
         r = np.ascontiguousarray(r)
-    # n + 3 draws, one more for the lateral velocity, two more for the increment (MEASURE_MEAN == 2)
-    u = rng.uniform(-1.0, 1.0, n + 3 + (measured & MEASURE_LATERAL) + (measured & MEASURE_MEAN))
-    if noise.outlier_prob > 0:
+    model = suite._model  # what the kernel reads of the noise, built once per noise configuration
+    if model[0] is not noise or model[1] != tol:
+        rm = _record_model(suite, noise, tol)
+        model = (noise, tol, rm.r_max, rm.scalars(), noise.outlier_prob > 0)
+        object.__setattr__(suite, "_model", model)
+    _, _, r_max, scalars, draw_outliers = model
+    # n + 3 draws, one more for the lateral velocity, two more for the increment (MEASURE_MEAN == 2); the
+    # kernel reads each as -1 + 2 u, the value of rng.uniform(-1.0, 1.0) (record_kernel)
+    u = rng.random(n + 3 + (measured & MEASURE_LATERAL) + (measured & MEASURE_MEAN))
+    if draw_outliers:
         flag, o_lo, o_hi = outliers(n, noise.outlier_prob, suite.r_max, noise.range, rng, noise.max_outliers)
     else:
-        flag = np.zeros(n, dtype=bool)
-        o_lo = o_hi = suite._k_r_max
+        flag, o_lo, o_hi = np.zeros(n, dtype=bool), r_max, r_max
     out, no_echo = np.empty((n + 6, 2)), np.empty(n, dtype=bool)
-    model = suite._model  # the kernel's RecordModel, built once per noise configuration
-    if model[0] is not noise or model[1] != tol:
-        model = (noise, tol, _record_model(suite, noise, tol))
-        object.__setattr__(suite, "_model", model)
-    bad = record_kernel(r, hulls, float(heading), measured, model[2], u, flag, o_lo, o_hi, out, no_echo)
+    bad = record_kernel(r, hulls, float(heading), measured, r_max, scalars, u, flag, o_lo, o_hi, out, no_echo)
     if bad >= 0:
         name = _ROWS[bad] if bad < 3 else f"range[{bad - 3}]" if bad < n + 3 else _TAIL[bad - n - 3]
         raise ValueError(f"{name}: interval is not [lo <= hi]: {out[bad].tolist()}")
@@ -210,20 +214,20 @@ def _record(
     :func:`record_kernel` has checked: the same fields as ``MissionRecord(...)``, without re-running its
     per-field conversions and checks each step (``tests/envs/sim/test_kernels.py`` checks the two agree)."""
     rec = MissionRecord.__new__(MissionRecord)
-    rec.__dict__.update(
-        t=np.asarray(t, dtype=np.float64),
-        speed=out[0],
-        yaw_rate=out[1],
-        heading=out[2],
-        alpha=suite.alpha,
-        gamma=suite.gamma,
-        r_max=suite.r_max,
-        range=out[3:-3],
-        no_echo=no_echo,
-        outlier=flag,
-        lateral=out[-3],
-        mean_velocity=out[-2:],
-    )
+    rec.__dict__ = {
+        "t": np.array(t),  # a float: float64
+        "speed": out[0],
+        "yaw_rate": out[1],
+        "heading": out[2],
+        "alpha": suite.alpha,
+        "gamma": suite.gamma,
+        "r_max": suite.r_max,
+        "range": out[3:-3],
+        "no_echo": no_echo,
+        "outlier": flag,
+        "lateral": out[-3],
+        "mean_velocity": out[-2:],
+    }
     return rec
 
 

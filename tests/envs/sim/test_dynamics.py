@@ -30,7 +30,13 @@ from premise import (
 )
 
 from digslam.envs import ExploreEnv, World
-from digslam.envs.sim.dynamics_jit import free_radius, step_bounds, substep_clear, substep_times
+from digslam.envs.sim.dynamics_jit import (
+    free_radius,
+    step_bounds,
+    step_bounds_free,
+    substep_clear,
+    substep_times,
+)
 from digslam.envs.sim.geometry_jit import edge_boxes
 from digslam.envs.sim.robot import RobotSim
 
@@ -265,3 +271,40 @@ def test_the_checker_catches_a_disc_overlap_and_a_bad_velocity() -> None:
 
     with pytest.raises(PremiseViolation, match="lateral"):
         chk.check_path(np.array([[0.0, 0.0, 0.0], [0.0, 0.05, 0.0], [0.0, 0.05, 0.0]]), taus, Rec())
+
+
+# --- the same work, less overhead ----------------------------------------------------------------------------
+def test_step_bounds_free_is_step_bounds_then_free_radius() -> None:
+    """The simulator's one call after a step: the hulls of :func:`step_bounds` and the :func:`free_radius` of
+    the step's end, bit for bit."""
+    env = _env("rocks")
+    env.reset(seed=0)
+    assert env.world is not None
+    edges, bbox = env.world.edges, env.world.bbox
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        start = np.array([rng.uniform(-8, 8), rng.uniform(-8, 8), 0.0])
+        states = start + np.cumsum(rng.normal(0.0, 0.05, (5, 3)), axis=0)
+        taus = substep_times(0.1, 4)
+        a, b = np.empty((5, 2)), np.empty((5, 2))
+        step_bounds(states, taus, a)
+        rho = free_radius(states[-1, 0], states[-1, 1], 0.2, 1.0, edges, bbox)
+        assert step_bounds_free(states, taus, b, 0.2, 1.0, edges, bbox) == rho
+        assert np.array_equal(a, b)
+
+
+def test_substeps_calling_chipmunk_directly_match_space_step() -> None:
+    """The substeps call chipmunk's step directly while the space's queues are empty; a queued body sends
+    them through ``Space.step``. Both give the same states, bit for bit, contacts and bumps included."""
+    frame = np.array([(-5.0, -5.0), (5.0, -5.0), (5.0, 5.0), (-5.0, 5.0)])
+    world = World((-5, -5, 5, 5), [frame])
+    pose = np.array([3.5, 0.0, math.radians(30)])
+    direct, wrapped = (RobotSim(world, 0.2, pose, skin=0.0375, dynamics="pymunk") for _ in range(2))
+    rng = np.random.default_rng(5)
+    for v, w in zip(rng.uniform(-0.5, 1.5, 80), rng.uniform(-2.0, 2.0, 80), strict=True):
+        wrapped.space._bodies_to_check.add(wrapped.body)  # pymunk checks its mass: Space.step it is
+        assert direct.step(v, w, 0.1, 4) == wrapped.step(v, w, 0.1, 4)
+        assert np.array_equal(direct.states, wrapped.states) and np.array_equal(direct.hulls, wrapped.hulls)
+        ends = [(sim.speed, sim.lateral, sim.yaw_rate, sim.speed_hull) for sim in (direct, wrapped)]
+        assert ends[0] == ends[1]
+    assert direct.bumps == wrapped.bumps >= 1 and direct.stops == wrapped.stops

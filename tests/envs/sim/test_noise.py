@@ -92,3 +92,13 @@ def test_negative_noise_bounds_are_rejected() -> None:
         NoiseConfig.from_dict({"rnage": 0.1})
     with pytest.raises(ValueError, match="modle"):
         ExploreConfig(noise={"modle": "uniform"})
+
+
+def test_the_record_draws_are_those_of_uniform() -> None:
+    """``record_step`` draws ``rng.random`` and its kernel reads each as ``-1 + 2 u``: bit for bit the values of
+    ``rng.uniform(-1, 1)``, with the generator left in the same state (records stay reproducible)."""
+    a, b = np.random.default_rng(11), np.random.default_rng(11)
+    for k in (1, 12, 15, 1000, 100_000):
+        want, got = a.uniform(-1.0, 1.0, k), -1.0 + 2.0 * b.random(k)
+        assert np.array_equal(want.view(np.int64), got.view(np.int64))
+    assert a.bit_generator.state == b.bit_generator.state
