@@ -1,24 +1,29 @@
-"""Certified coverage of the coverage agents on held-out maps of ``digslam/DigCoverage-v0``.
+"""The coverage benchmark: every agent on the test levels of every generator, certified coverage uncapped.
 
 Every baseline of :data:`digslam.agents.baselines.registry.BASELINES` (and the PPO policy
 ``agents/data/ppo_digcoverage.zip`` when it exists, on the env keywords of its ``.json`` sidecar: they
-change the observation, not the maps) runs on the same ``--maps`` maps, map ``i`` being
-``reset(seed=--seed + i)`` with the world regenerated, for ``--steps`` steps. The env keeps its defaults,
-including its termination at the target coverage (0.8): a curve stays at its last value once its episode
-ended (``--target 1.0`` removes that cap). Prints the table (mean ± std of the certified coverage at 1000
-and 3000 steps, or at ``--steps``), each agent's means, and on the last line
-``ppo_vs_best_baseline=<PPO mean / best baseline mean at the last reported step>`` (``nan`` without a model).
+change the observation, not the levels) runs on the same ``--maps`` levels of each generator of
+:data:`digslam.agents.evaluation.suite.GENERATORS` (room, rocks, caves, rooms): the first seeds of the test
+split (``digslam.envs.splits``), ``target=1.0`` (no early end), ``--steps`` steps
+(:func:`digslam.agents.evaluation.suite.run_suite`). Prints the leaderboard (T90 per generator with its
+success rate, T90 / AUC / final tube over all maps, and the ratio to the best baseline with its paired
+bootstrap 95 % interval), writes ``leaderboard.md``, ``leaderboard.png`` and ``suite.json`` to ``--out``,
+and ends with ``heuristic_t90_success=<share of the test maps, over all generators, on which the best
+baseline reaches 0.9 certified coverage>`` and ``eval_steps_per_s=<observed env steps per second with the
+frontier agent, one process>``.
 
-Usage: ``python benchmarks/bench_agents.py [--maps 20] [--steps 3000] [--seed 2000000] [--target T]
-[--model PATH] [--out DIR]``. The env runs at roughly 250 steps/s on one core: the full benchmark (4
-baselines x 20 maps x 3000 steps) takes about half an hour or more; ``--maps 3 --steps 1000`` runs smaller.
+Usage: ``python benchmarks/bench_agents.py [--quick] [--maps 30] [--steps 3000] [--out DIR] [--model PATH]
+[--ray [--address A] [--workers N]]`` (also ``digslam benchmark agents ...``). The full suite (4 generators x
+30 maps x 3000 steps x 5 agents, about 1.8 M steps) takes about an hour on one core; ``--quick`` (3 maps,
+300 steps) a minute. ``--ray`` runs the same suite on a pool of Ray actors
+(:func:`digslam.agents.evaluation.ray_eval.run_suite_ray`; a local instance with ``--workers`` CPUs, or the
+cluster at ``--address``) with identical results; ``eval_steps_per_s`` is still measured in this process.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import math
 import time
 from pathlib import Path
 from typing import Any
@@ -27,8 +32,9 @@ import gymnasium as gym
 
 import digslam.envs  # noqa: F401  (registers the environments)
 from digslam.agents.baselines.registry import BASELINES, make_baseline
-from digslam.agents.evaluation.evaluate import EvalResult, coverage_figure, evaluate
-from digslam.envs.splits import TEST
+from digslam.agents.evaluation.metrics import paired_bootstrap_ratio
+from digslam.agents.evaluation.ray_eval import run_suite_ray
+from digslam.agents.evaluation.suite import run_suite, steps_per_second
 
 ENV_ID = "digslam/DigCoverage-v0"
 MODEL = Path(__file__).resolve().parents[1] / "agents" / "data" / "ppo_digcoverage.zip"
@@ -60,62 +66,56 @@ def load_ppo(model: Path) -> Any:
     return PPO.load(str(model), device="cpu")
 
 
-def merge(a: EvalResult, b: EvalResult) -> EvalResult:
-    """``a`` with ``b``'s agents added."""
-    return EvalResult(
-        {**a.curves, **b.curves},
-        {**a.true_curves, **b.true_curves},
-        {**a.collisions, **b.collisions},
-        {**a.final_tube_width, **b.final_tube_width},
-        {**a.lengths, **b.lengths},
-        a.env_id,
-        a.seed,
-        a.n_maps,
-    )
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--maps", type=int, default=20, help="held-out maps (default 20)")
+    ap.add_argument("--maps", type=int, default=30, help="test levels per generator (default 30)")
     ap.add_argument("--steps", type=int, default=3000, help="steps per episode (default 3000)")
-    ap.add_argument(
-        "--seed", type=int, default=TEST.start, help=f"seed of map 0 (default {TEST.start}: the test split)"
-    )
-    ap.add_argument("--target", type=float, default=None, help="env's termination coverage (default: env's)")
+    ap.add_argument("--quick", action="store_true", help="a smoke run: 3 maps, 300 steps")
     ap.add_argument("--model", type=Path, default=MODEL, help="PPO model (.zip)")
-    ap.add_argument("--out", type=Path, default=None, help="also write coverage.png and evaluation.json here")
+    ap.add_argument(
+        "--out", type=Path, default=Path("out/leaderboard"), help="where to write the leaderboard"
+    )
+    ap.add_argument("--ray", action="store_true", help="run the suite on Ray actors (identical results)")
+    ap.add_argument("--address", default=None, help="with --ray: Ray cluster to attach to (default: local)")
+    ap.add_argument("--workers", type=int, default=None, help="with --ray: actors (default: one per CPU)")
     args = ap.parse_args()
-    kw: dict[str, Any] = {} if args.target is None else {"target": args.target}
-    env = gym.make(ENV_ID, **kw)
-    policies = {name: make_baseline(name, env, seed=0) for name in BASELINES}
+    if (args.address is not None or args.workers is not None) and not args.ray:
+        ap.error("--address/--workers: only with --ray")
+    maps, steps = (3, 300) if args.quick else (args.maps, args.steps)
+    env = gym.make(ENV_ID)
+    names = list(BASELINES) if not args.ray else ["frontier"]  # with --ray, only eval_steps_per_s runs here
+    policies: dict[str, Any] = {name: make_baseline(name, env, seed=0) for name in names}
     env.close()
-    t0 = time.perf_counter()
-    res = evaluate(policies, ENV_ID, n_maps=args.maps, seed=args.seed, steps=args.steps, env_kwargs=kw,
-                   progress=True)  # fmt: skip
+    extra = {}
     ppo = load_ppo(args.model)
     if ppo is not None:
-        pkw = {**model_kwargs(args.model), **kw}
-        print(f"PPO env keywords: {pkw}")
-        part = evaluate({"ppo": ppo}, ENV_ID, n_maps=args.maps, seed=args.seed, steps=args.steps,
-                        env_kwargs=pkw, progress=True)  # fmt: skip
-        res = merge(res, part)
+        policies["ppo"], extra["ppo"] = ppo, model_kwargs(args.model)
+        print(f"PPO env keywords: {extra['ppo']}")
+    t0 = time.perf_counter()
+    if args.ray:  # the same policies as specs: baselines sized from ENV_ID with seed 0, the PPO .zip
+        specs = {name: name for name in BASELINES} | ({"ppo": str(args.model)} if ppo is not None else {})
+        res = run_suite_ray(specs, n_maps=maps, steps=steps, agent_env_kwargs=extra, address=args.address,
+                            workers=args.workers, policy_env=ENV_ID, policy_seed=0, progress=True)  # fmt: skip
+    else:
+        res = run_suite(policies, n_maps=maps, steps=steps, agent_env_kwargs=extra, progress=True)
     wall = time.perf_counter() - t0
-    at = [s for s in (1000, 3000) if s <= args.steps] or [args.steps]
-    print(f"{ENV_ID}: {args.maps} maps (seeds {args.seed}..{args.seed + args.maps - 1}), {args.steps} steps, "
-          f"env keywords {kw or 'default'}; {wall:.0f} s")  # fmt: skip
-    print(res.table(at=at))
-    for s in at:
-        means = {a: float(v.mean()) for a, v in res.at(s).items()}
-        print(f"certified_coverage@{s}: " + ", ".join(f"{a}={m:.4f}" for a, m in means.items()))
-    print("mean episode length (steps; < --steps when the target was reached): "
-          + ", ".join(f"{a}={float(v.mean()):.0f}" for a, v in res.lengths.items()))  # fmt: skip
-    if args.out is not None:
-        print(f"wrote {coverage_figure(res, args.out / 'coverage.png')} and "
-              f"{res.to_json(args.out / 'evaluation.json')}")  # fmt: skip
-    last = {a: float(v.mean()) for a, v in res.at(at[-1]).items()}
-    best = max((m for a, m in last.items() if a != "ppo"), default=math.nan)
-    ratio = last["ppo"] / best if "ppo" in last and best > 0 else math.nan
-    print(f"ppo_vs_best_baseline={ratio:.4f}" if math.isfinite(ratio) else "ppo_vs_best_baseline=nan")
+    print(f"{len(res.results)} generators x {maps} test maps (seeds {res.seeds[0]}..{res.seeds[-1]}), "
+          f"{steps} steps, target 1.0; {wall:.0f} s")  # fmt: skip
+    table = res.table(list(BASELINES))
+    print(table)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "leaderboard.md").write_text(table + "\n")
+    print(f"wrote {args.out / 'leaderboard.md'}, {res.figure(args.out / 'leaderboard.png')} and "
+          f"{res.to_json(args.out / 'suite.json')}")  # fmt: skip
+    best = res.best(list(BASELINES))
+    if ppo is not None:
+        t = res.t90()
+        r, lo, hi = paired_bootstrap_ratio(t[best], t["ppo"])
+        print(f"ppo_speedup_t90={r:.4f} [{lo:.4f}, {hi:.4f}] (T90 of {best} / T90 of ppo)")
+    rate = steps_per_second(policies["frontier"], ENV_ID, steps=min(2000, 10 * steps))
+    print(f"best_baseline={best}")
+    print(f"heuristic_t90_success={res.success(best):.4f}")
+    print(f"eval_steps_per_s={rate:.0f}")
 
 
 if __name__ == "__main__":

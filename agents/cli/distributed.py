@@ -21,11 +21,12 @@ def add_ray_options(parser: argparse.ArgumentParser) -> Callable[[argparse.Names
 
     The handler (also stored as the parser default ``ray_evaluate``) takes the parsed ``evaluate``
     arguments (``agents``, ``model``, ``env``, ``maps``, ``seed``, ``steps``) and returns the
-    ``EvalResult`` of :func:`~digslam.agents.evaluation.ray_eval.evaluate_ray`: ``"ppo"`` is the ``--model``
+    ``EvalResult`` of :func:`~digslam.agents.evaluation.ray_eval.evaluate_ray` (a pool of long-lived actors,
+    one per CPU, taking batches of episodes; the result is the sequential one): ``"ppo"`` is the ``--model``
     path (default the shipped policy, with the environment keywords of its sidecar), any other agent a
     baseline name (:func:`~digslam.agents.evaluation.ray_eval.agent_specs`).
     """
-    parser.add_argument("--ray", action="store_true", help="distribute the episodes over Ray (one task each)")
+    parser.add_argument("--ray", action="store_true", help="run the episodes on Ray actors (batches)")
     parser.add_argument(
         "--address", default=None, help="Ray cluster to attach to (e.g. auto, host:6379); default: local"
     )

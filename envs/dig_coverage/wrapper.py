@@ -82,12 +82,11 @@ from scipy import ndimage
 
 from digslam.envs.dig_coverage.config import ObserverConfig
 from digslam.envs.dig_coverage.maps_jit import (
-    MapContext,
     MapPlanes,
     crop_window,
     fill_map,
     map_context,
-    observe,
+    observe_step,
 )
 from digslam.envs.dig_coverage.monitor import GuaranteeMonitor
 from digslam.envs.explore.coverage import Coverage
@@ -200,7 +199,11 @@ class GuaranteedObserver(gym.Wrapper):
         self._explored_all, self._clear_all = self._planes[0].view(np.int8), self._planes[1].view(np.bool_)
         self._dark_all, self._base, self._n = self._planes[2].view(np.bool_), np.zeros((3, m, m), np.uint8), 0
         self._xs, self._nys = np.array(g.xs, np.float64), np.array(-g.ys, np.float64)
-        self._maps: MapContext | None = None  # what :func:`.maps_jit.observe` reads and keeps: each reset
+        # what :func:`.maps_jit.observe_step` reads and keeps (each reset), as the plain tuple of its fields
+        self._maps: tuple = ()
+        # the certified count and the grid's number of clear cells, kept by :func:`.maps_jit.observe_step`
+        self._counts = np.zeros(2, np.int64)
+        self._img_shape, self._snap_shape = (self.n_channels, m, m), (3, *shape)
 
     # --- gymnasium API -------------------------------------------------------------------------------------
     def reset(self, **kwargs: Any) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
@@ -220,8 +223,8 @@ class GuaranteedObserver(gym.Wrapper):
         self.filter.reset(lo, hi, info["record"])
         f = self.filter
         sets = (f.sensed_sure, f.sensed_maybe, f.dig.free)
-        self._maps = map_context(sets, MapPlanes(*self._planes), self._base, self._xs, self._nys,
-                                 self.obs_config.horizon)  # fmt: skip
+        self._maps = tuple(map_context(sets, MapPlanes(*self._planes), self._base, self._xs, self._nys,
+                                       self.obs_config.horizon))  # fmt: skip
         self.steps, self._cache_step = 0, -1
         # ground truth over the cells of the certified coverage, the reachable free area (:mod:`.coverage`)
         self.truth_coverage = Coverage.on_cells(self.reachable[::-1], self.grid.lo, self.grid.cell_size,
@@ -261,26 +264,25 @@ class GuaranteedObserver(gym.Wrapper):
 
     def _sets(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
         """The filter's explored codes, clear and dark masks and certified cell count, once per step, with
-        the observation (:meth:`observation`): one compiled call (the kernel of
-        :func:`.maps_jit.observe`) keeps the sets and the map's clear / penumbra / dark channels up to
+        the observation (:meth:`observation`): one compiled call (:func:`.maps_jit.observe_step`)
+        keeps the sets and the map's clear / penumbra / dark channels up to
         date on the cells the step touched (:meth:`OnlineDigSlam.take_touched`) and draws the pose-box channel
         and the state; ``info`` gets copies of the sets."""
         if self._cache_step != self.steps:
-            f, (ny, nx) = self.filter, self.grid.shape
+            f, counts = self.filter, self._counts
             win = f.take_touched()
-            if win == (0, ny, 0, nx):  # after a reset: everything (and the reachable area may be new)
-                self._clear_all[:] = False
-                self._n = 0
-            m = self.obs_config.map_size
-            img, state = np.empty((self.n_channels, m, m), np.uint8), np.empty(N_STATE, dtype=np.float32)
-            snap = np.empty((3, ny, nx), np.uint8)  # info's explored, clear and dig
-            heading = (f.heading_lo, f.heading_hi)
-            self._n = int(observe(self._maps, f.pose_lo, f.pose_hi, heading, win, self.steps, self._n, img,
-                                  state, snap))  # fmt: skip
+            if win == (0, self._snap_shape[1], 0, self._snap_shape[2]):  # after a reset: everything (and the
+                self._clear_all[:] = False  # reachable area may be new): both counts from scratch
+                counts[0], counts[1] = 0, -1
+            img, state = np.empty(self._img_shape, np.uint8), np.empty(N_STATE, dtype=np.float32)
+            snap = np.empty(self._snap_shape, np.uint8)  # info's explored, clear and dig
+            observe_step(self._maps, f.pose_lo, f.pose_hi, (f.heading_lo, f.heading_hi), win, self.steps,
+                         counts, img, state, snap)  # fmt: skip
+            self._n = n = int(counts[0])
             if self.obs_config.crop is not None:
                 self._crop(img)
             self._obs = (img, state)
-            self._cache = (snap[0].view(np.int8), snap[1].view(np.bool_), self._dark_all, self._n)
+            self._cache = (snap[0].view(np.int8), snap[1].view(np.bool_), self._dark_all, n)
             self._dig_copy = snap[2].view(np.bool_)
             self._cache_step = self.steps
         return self._cache

@@ -51,6 +51,7 @@ from .pose_jit import (
 )
 from .step_jit import (
     filter_step,
+    filter_step_flat,
     filter_step_q,
 )
 from .window import (
@@ -84,6 +85,7 @@ __all__ = [
     "dig_reading",
     "edge_direction",
     "filter_step",
+    "filter_step_flat",
     "filter_step_q",
     "grid_frame",
     "impact_bound",

@@ -18,7 +18,7 @@ Each :meth:`OnlineDigSlam.update` takes the next single-step record and
 4. optionally (``smoothing_window = W``) contracts the last ``W`` boxes backward,
    ``x_j &= x_{j+1} - [d_j]``, and digs again the readings of the boxes that shrank.
 
-Steps 1–3 run as one compiled call (:func:`.step_jit.filter_step`, the same kernels chained), and
+Steps 1–3 run as one compiled call (:func:`.step_jit.filter_step_flat`, the same kernels chained), and
 :attr:`OnlineDigSlam.touched` grows by the smallest window holding the cells the step changed.
 
 State is a fixed set of arrays (plus a ring of ``W`` steps): memory does not grow with the episode.
@@ -74,7 +74,7 @@ from digslam.observer.core import rounding as rnd
 from digslam.observer.core.config import Config, check, check_int, config_dataclass
 from digslam.observer.online.dig_jit import NO_MEAN, CellSets, PoseBox, StepRecord
 from digslam.observer.online.mark_jit import dig_and_mark_q
-from digslam.observer.online.step_jit import filter_step_q
+from digslam.observer.online.step_jit import filter_step_flat
 from digslam.observer.online.window import WindowDigMap
 from digslam.observer.slam.grid import Grid
 from digslam.observer.slam.record import MissionRecord
@@ -162,6 +162,8 @@ class OnlineDigSlam:
         self._lst = np.zeros(self.grid.shape[0] * self.grid.shape[1] + 1 if self._q else 1, dtype=np.int32)
         #: The cell sets as the kernels read them (:class:`.dig_jit.CellSets`), built once per episode.
         self.cells = CellSets(self.dig.free, self.sensed_sure, self.sensed_maybe, self._cnt, self._lst)
+        # the same, and the grid's frame, as plain tuples: what :func:`.step_jit.filter_step_flat` takes
+        self._cells_t, self._frame_t = tuple(self.cells), tuple(self.dig.frame)
         self.consistent = False
         self.inconsistent_step: int | None = None
         self.steps, self.last_update_seconds = 0, 0.0
@@ -174,12 +176,19 @@ class OnlineDigSlam:
             raise ValueError(f"{name}: expected a single-step MissionRecord (scalar t)")
         prev = self._prev
         if name == "rec" and prev is not None:
-            if rec.alpha.shape[-1] != prev.alpha.shape[-1]:  # n_sensors
-                n = prev.n_sensors
-                raise ValueError(f"{name}: {rec.n_sensors} sensors, the episode started with {n}")
-            if not float(rec.t) > float(prev.t):
-                raise ValueError(f"{name}: time {float(rec.t)} does not follow {float(prev.t)}")
+            self._step_dt(rec, prev)
         return rec
+
+    @staticmethod
+    def _step_dt(rec: MissionRecord, prev: MissionRecord) -> float:
+        """``t_k - t_{k-1}`` of ``rec`` after ``prev`` (raises if they do not follow each other)."""
+        if rec.alpha.shape[-1] != prev.alpha.shape[-1]:  # n_sensors
+            n = prev.n_sensors
+            raise ValueError(f"rec: {rec.n_sensors} sensors, the episode started with {n}")
+        t, t0 = float(rec.t), float(prev.t)
+        if not t > t0:
+            raise ValueError(f"rec: time {t} does not follow {t0}")
+        return t - t0
 
     def reset(self, x0_lo: Any, x0_hi: Any, first: MissionRecord) -> None:
         """Start an episode from the box ``X₀`` (Eq. 6.15) and the record at ``t_0``."""
@@ -200,15 +209,21 @@ class OnlineDigSlam:
         """Fold in the next single-step record (does nothing once inconsistent)."""
         if self._prev is None:
             raise ValueError("rec: call reset() before update()")
-        rec = self._check_record(rec)
+        if not isinstance(rec, MissionRecord) or rec.t.ndim != 0:
+            raise ValueError("rec: expected a single-step MissionRecord (scalar t)")
+        dt = self._step_dt(rec, self._prev)
         if not self.consistent:
             return
         start = time.perf_counter()
-        step = _step_record(rec, float(rec.t) - float(self._prev.t))
+        # the kernels' StepRecord as a plain tuple of its fields (not copied): see filter_step_flat
+        lat = rec.lateral if rec.lateral is not None else _NO_SLIP
+        mean = rec.mean_velocity if rec.mean_velocity is not None else NO_MEAN
+        step = (dt, rec.speed, lat, rec.yaw_rate, rec.heading, rec.alpha, rec.gamma, rec.r_max, rec.range,
+                rec.no_echo, mean)  # fmt: skip
         # the kernel overwrites copies of the state: the arrays handed out are never changed
         lo, hi, psi = self.pose_lo.copy(), self.pose_hi.copy(), np.array((self.heading_lo, self.heading_hi))
-        code, r0, r1, c0, c1, d = filter_step_q(self.cells, self.dig.frame, step, lo, hi, psi, self._impacts,
-                                                self._q)  # fmt: skip
+        code, r0, r1, c0, c1, d = filter_step_flat(self._cells_t, self._frame_t, step, lo, hi, psi,
+                                                   self._impacts, self._q)  # fmt: skip
         if code:
             return self._fail(start)
         self.pose_lo, self.pose_hi = lo, hi
@@ -216,7 +231,7 @@ class OnlineDigSlam:
         self._touch(r0, r1, c0, c1)
         if self.config.smoothing_window:
             band = (self.heading_lo, self.heading_hi)
-            self._ring.append([step, self.pose_lo.copy(), self.pose_hi.copy(), band, d])
+            self._ring.append([StepRecord(*step), self.pose_lo.copy(), self.pose_hi.copy(), band, d])
         self._prev = rec
         self.steps += 1
         if self.config.smoothing_window and not self._smooth():

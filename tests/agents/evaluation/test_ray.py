@@ -1,7 +1,9 @@
-"""Ray scale-out (issue 11): distributed evaluation equals the single-machine one; sweeps run end to end.
+"""Ray scale-out (issues 11, 18): the actor-pool evaluation and suite equal the sequential ones, bit for bit;
+batches are balanced and in map order; sweeps run end to end.
 
-Skipped when ray (the ``ray`` extra) is not installed. The evaluation test starts one local Ray instance
-with 2 CPUs; the sweep test (2 trials of 256 timesteps) is marked expensive.
+Skipped when ray (the ``ray`` extra) is not installed. Two tests start a local Ray instance with 2 CPUs
+(``evaluate_ray`` and ``run_suite_ray``, each starting and shutting down its own); the batching tests need
+no Ray; the sweep test (2 trials of 256 timesteps, ``ray[tune]``) is marked expensive.
 """
 
 from __future__ import annotations
@@ -15,12 +17,31 @@ import numpy as np
 import pytest
 
 ray = pytest.importorskip("ray")
-pytest.importorskip("ray.tune")
+
+
+def _has_tune() -> bool:
+    try:
+        import ray.tune  # noqa: F401
+    except ImportError:  # ray without the tune extra: only the sweep test needs it
+        return False
+    return True
+
+
+needs_tune = pytest.mark.skipif(not _has_tune(), reason="ray[tune] is not installed")
 
 from digslam.agents.cli.distributed import add_ray_options as add_eval_cli  # noqa: E402
 from digslam.agents.cli.distributed import add_sweep_parser as add_sweep_cli  # noqa: E402
 from digslam.agents.evaluation.evaluate import evaluate  # noqa: E402
-from digslam.agents.evaluation.ray_eval import build_policy, evaluate_ray, merge_results, normalize_specs  # noqa: E402
+from digslam.agents.evaluation.ray_eval import (  # noqa: E402
+    build_policy,
+    evaluate_ray,
+    merge_results,
+    normalize_specs,
+    plan_batches,
+    run_suite_ray,
+    split_batches,
+)
+from digslam.agents.evaluation.suite import run_suite  # noqa: E402
 from digslam.agents.learning.sweep import SweepConfig, run_sweep  # noqa: E402
 
 ENV = "digslam/DigCoverage-v0"
@@ -39,17 +60,65 @@ def assert_same_result(a: object, b: object) -> None:
 
 
 def test_distributed_evaluation_matches_single_machine() -> None:
-    """2 maps x 2 agents, 30 steps: one Ray task per (agent, map) on 2 CPUs gives the very same arrays."""
+    """3 maps x 2 agents, 30 steps on a pool of 2 actors (blocks of one and two maps): the very same arrays
+    as the sequential evaluation."""
     specs = {"frontier": "frontier", "lawnmower": "lawnmower"}
-    dist = evaluate_ray(specs, env_id=ENV, n_maps=2, seed=1000, steps=30, env_kwargs=SMALL, num_cpus=2)
+    dist = evaluate_ray(specs, env_id=ENV, n_maps=3, seed=1000, steps=30, env_kwargs=SMALL, num_cpus=2)
     assert not ray.is_initialized()  # the local instance it started is shut down
-    local = evaluate({n: build_policy(s, ENV, SMALL) for n, s in specs.items()}, env_id=ENV, n_maps=2,
+    local = evaluate({n: build_policy(s, ENV, SMALL) for n, s in specs.items()}, env_id=ENV, n_maps=3,
                      seed=1000, steps=30, env_kwargs=SMALL)  # fmt: skip
     assert_same_result(dist, local)
-    assert dist.curves["frontier"].shape == (2, 31)
-    assert dist.seed == 1000 and dist.n_maps == 2
+    assert dist.curves["frontier"].shape == (3, 31)
+    assert dist.seed == 1000 and dist.n_maps == 3
     assert dist.table(at=(30,)) == local.table(at=(30,))
     assert not np.array_equal(dist.curves["frontier"][0], dist.curves["frontier"][1])  # two different maps
+
+
+def test_suite_on_ray_gives_the_sequential_tables() -> None:
+    """The suite (random with seed 0, frontier; 2 generators x 2 test maps x 25 steps) on 2 actors: the
+    same SuiteResult, table and metrics as ``run_suite`` in this process."""
+    import gymnasium as gym
+
+    from digslam.agents.baselines.registry import make_baseline
+
+    env = gym.make(ENV)
+    local_policies = {n: make_baseline(n, env, seed=0) for n in ("random", "frontier")}
+    env.close()
+    gens = ["room", "rocks"]
+    seq = run_suite(local_policies, n_maps=2, steps=25, generators=gens)
+    dist = run_suite_ray(["random", "frontier"], n_maps=2, steps=25, generators=gens, workers=2)
+    assert not ray.is_initialized()
+    assert (dist.steps, dist.split, dist.seeds) == (seq.steps, seq.split, seq.seeds)
+    assert list(dist.results) == gens
+    for g in gens:
+        assert_same_result(dist.results[g], seq.results[g])
+    assert dist.table(["random", "frontier"]) == seq.table(["random", "frontier"])
+    with pytest.raises(ValueError, match="generators"):
+        run_suite_ray(["frontier"], n_maps=1, steps=5, generators=["moon"])
+
+
+def test_batches_are_balanced_contiguous_and_in_order() -> None:
+    for n in range(1, 40):
+        for k in range(1, 12):
+            blocks = split_batches(n, k)
+            assert len(blocks) == min(n, k)
+            assert blocks[0][0] == 0 and blocks[-1][1] == n
+            assert all(b[1] == c[0] for b, c in zip(blocks, blocks[1:], strict=False))  # contiguous, in order
+            sizes = [b - a for a, b in blocks]
+            assert min(sizes) >= 1 and max(sizes) - min(sizes) <= 1 and sizes == sorted(sizes, reverse=True)
+    assert split_batches(10, 4) == [(0, 3), (3, 6), (6, 8), (8, 10)]
+    with pytest.raises(ValueError, match="n_maps"):
+        split_batches(0, 2)
+    # the suite of bench_sweep: 2 jobs of 20 maps on 2 actors -> 8 blocks of 5, 4 per job, jobs in order
+    plan = plan_batches([20, 20], n_actors=2)
+    assert plan == [(j, a, a + 5) for j in (0, 1) for a in range(0, 20, 5)]
+    # many small jobs: at least one block each, about 4 per actor in all, every map exactly once
+    plan = plan_batches([3, 1, 2, 5, 4], n_actors=2)
+    assert plan[:3] == [(0, 0, 2), (0, 2, 3), (1, 0, 1)]  # ceil(8 / 5) = 2 blocks per job
+    for j, n in enumerate([3, 1, 2, 5, 4]):
+        maps = [i for jj, a, b in plan if jj == j for i in range(a, b)]
+        assert maps == list(range(n))
+    assert plan_batches([], 2) == []
 
 
 def test_merge_results_stacks_maps_in_order() -> None:
@@ -101,6 +170,7 @@ def test_sweep_config_rejects_unknown_and_bad_keys(tmp_path: Path) -> None:
     assert dataclasses.is_dataclass(cfg) and cfg.__dataclass_params__.frozen
 
 
+@needs_tune
 def test_example_sweep_file_and_cli(tmp_path: Path) -> None:
     example = Path(__file__).resolve().parents[3] / "agents" / "configs" / "sweep_example.toml"
     cfg = SweepConfig.from_file(example)
@@ -145,6 +215,7 @@ def test_evaluate_ray_handler_on_the_cli_parser(monkeypatch: pytest.MonkeyPatch,
 
 
 @pytest.mark.expensive
+@needs_tune
 def test_tiny_sweep_end_to_end(tmp_path: Path) -> None:
     """2 trials (two learning rates) of 256 timesteps on a local Ray instance with 2 CPUs: the table,
     the CSV, the trials' models; resuming the finished sweep gives the same table."""
@@ -168,3 +239,23 @@ def test_tiny_sweep_end_to_end(tmp_path: Path) -> None:
         run_sweep(cfg, num_cpus=2)
     again, _ = run_sweep(cfg, resume=True, num_cpus=2)
     assert again == table
+
+
+def test_benchmark_agents_ray_flags_reach_the_script(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``digslam benchmark agents --ray --address A --workers N`` runs bench_agents.py with those arguments,
+    which its parser accepts (``--address``/``--workers`` only with ``--ray``)."""
+    import subprocess
+    import sys
+
+    from digslam.agents.cli import commands
+    from digslam.agents.cli.main import build_parser
+
+    args = build_parser().parse_args(["benchmark", "agents", "--quick", "--ray", "--address", "auto",
+                                      "--workers", "2"])  # fmt: skip
+    calls: list[list[str]] = []
+    monkeypatch.setattr(commands.subprocess, "call", lambda cmd: calls.append(cmd) or 0)
+    assert commands.cmd_benchmark(args) == 0
+    assert calls[0][0] == sys.executable and calls[0][1].endswith("bench_agents.py")
+    assert calls[0][2:] == ["--quick", "--ray", "--address", "auto", "--workers", "2"]
+    out = subprocess.run([sys.executable, calls[0][1], "--workers", "2"], capture_output=True, text=True)
+    assert out.returncode == 2 and "only with --ray" in out.stderr
