@@ -34,7 +34,7 @@ import math
 
 import numpy as np
 
-from digslam.observer.core.angles_jit import axes_in
+from digslam.observer.core.angles_jit import sector_box
 from digslam.observer.core.scalar_jit import njit
 
 #: Bins of the per-step radius lookup table over pseudo-angles ``[0, 4)``.
@@ -262,17 +262,7 @@ def cover_step(todo: np.ndarray, blocks: np.ndarray, seen: np.ndarray, geo: np.n
         a0, a1 = wr[b], (wr[b + 1] if b + 1 < B else wr[0] + two_pi)
         c0, s0 = cs[b], sn[b]  # cos and sin of a0 and a1, computed once per bearing
         c1, s1 = (cs[b + 1], sn[b + 1]) if b + 1 < B else (math.cos(a1), math.sin(a1))
-        xlo, xhi = min(0.0, R * c0, R * c1), max(0.0, R * c0, R * c1)
-        ylo, yhi = min(0.0, R * s0, R * s1), max(0.0, R * s0, R * s1)
-        east, north, west, south = axes_in(a0, a1)
-        if east:
-            xhi = max(xhi, R)
-        if north:
-            yhi = max(yhi, R)
-        if west:
-            xlo = min(xlo, -R)
-        if south:
-            ylo = min(ylo, -R)
+        xlo, xhi, ylo, yhi = sector_box(R, a0, a1, c0, s0, c1, s1)
         ia, ib, ja, jb = _box(i0, i1, j0, j1, x, y, xs, ys, resx, resy, xlo, xhi, ylo, yhi)
         if ia >= ib or ja >= jb or not _any_todo(todo, blocks, ia, ib, ja, jb, xs, ys, x, y, r2[b]):
             continue

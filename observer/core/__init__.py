@@ -37,6 +37,7 @@ cache.guard()  # before any kernel is loaded: an edited kernel source never runs
 
 from .angles_jit import (
     axes_in,
+    sector_box,
 )
 from .arith import (
     abs_,
@@ -205,6 +206,7 @@ __all__ = [
     "atan",
     "atan2",
     "axes_in",
+    "sector_box",
     "bisect",
     "box_difference",
     "check",

@@ -18,7 +18,7 @@ import math
 from digslam.observer.core.rounding import HALF_PI_DOWN, HALF_PI_UP
 from digslam.observer.core.scalar_jit import njit
 
-__all__ = ["axes_in"]
+__all__ = ["axes_in", "sector_box"]
 
 
 @njit
@@ -58,3 +58,25 @@ def axes_in(a: float, b: float) -> tuple[bool, bool, bool, bool]:
             else:
                 south = True
     return east, north, west, south
+
+
+@njit(inline="always")
+def sector_box(r: float, a0: float, a1: float, c0: float, s0: float, c1: float, s1: float
+               ) -> tuple[float, float, float, float]:  # fmt: skip
+    """``(x_lo, x_hi, y_lo, y_hi)``: the bounding box, relative to its apex, of the circular sector of radius
+    ``r >= 0`` over the angles ``[a0, a1]``, given ``(c0, s0)`` and ``(c1, s1)``, the cosines and sines (as
+    computed by the caller) of its two ends: the apex, the two edge ends and the axis points ``r·(±1, 0)``,
+    ``r·(0, ±1)`` of the directions :func:`axes_in` reports inside the range (a caller pads for the
+    rounding of ``r·c``, ``r·s`` and of its ends)."""
+    xlo, xhi = min(0.0, r * c0, r * c1), max(0.0, r * c0, r * c1)
+    ylo, yhi = min(0.0, r * s0, r * s1), max(0.0, r * s0, r * s1)
+    east, north, west, south = axes_in(a0, a1)
+    if east:
+        xhi = max(xhi, r)
+    if north:
+        yhi = max(yhi, r)
+    if west:
+        xlo = min(xlo, -r)
+    if south:
+        ylo = min(ylo, -r)
+    return xlo, xhi, ylo, yhi

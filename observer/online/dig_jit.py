@@ -42,7 +42,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from digslam.observer.core.angles_jit import axes_in
+from digslam.observer.core.angles_jit import sector_box
 from digslam.observer.core.grid_jit import window
 from digslam.observer.core.rounding import PI_DOWN
 from digslam.observer.core.scalar_jit import (
@@ -268,21 +268,10 @@ def cone_window(grid: GridFrame, box: PoseBox, t1: float, t2: float, r: float, p
     The extreme points are the apex, the two edge ends ``r (c_k, s_k)`` (the lower ends of ``e1``, ``e2``,
     :func:`edge_direction` of ``t1``, ``t2``: within ``10⁻¹⁵`` of ``cos``, ``sin``) and the axis points
     ``r·(±1, 0)``, ``r·(0, ±1)`` of the directions inside ``[t1, t2]``
-    (:func:`~digslam.observer.core.angles_jit.axes_in`, which never misses one); ``pad`` (two cells) covers
-    the rounding of these values.
+    (:func:`~digslam.observer.core.angles_jit.sector_box`, whose axes never miss one); ``pad`` (two cells)
+    covers the rounding of these values.
     """
-    c1, s1, c2, s2 = e1[0], e1[2], e2[0], e2[2]
-    ax0, ax1 = min(0.0, r * c1, r * c2), max(0.0, r * c1, r * c2)
-    ay0, ay1 = min(0.0, r * s1, r * s2), max(0.0, r * s1, r * s2)
-    east, north, west, south = axes_in(t1, t2)
-    if east:
-        ax1 = max(ax1, r)
-    if north:
-        ay1 = max(ay1, r)
-    if west:
-        ax0 = min(ax0, -r)
-    if south:
-        ay0 = min(ay0, -r)
+    ax0, ax1, ay0, ay1 = sector_box(r, t1, t2, e1[0], e1[2], e2[0], e2[2])
     return window(grid.xs, grid.nys, box.x_lo + ax0 - pad, box.y_lo + ay0 - pad, box.x_hi + ax1 + pad,
                   box.y_hi + ay1 + pad)  # fmt: skip
 
