@@ -5,6 +5,13 @@ All plan on the observation's map (:mod:`.planning`): the traversable pixels are
 re-plan gives the path lengths to every pixel, a goal is the cheapest candidate pixel, and the waypoint is
 the farthest pixel of its path in straight sight. The robot turns in place and drives straight.
 
+The soft planner (``soft=True``, the default) runs that Dijkstra over every pixel not dark, each at a cost:
+1 on the traversable pixels, ``edge_weight`` on the other clear ones, ``penumbra_weight`` on penumbra. A
+corridor about as wide as the robot plus the pose box is clear only along a strip narrower than the
+erosion (penumbra along both walls): the plain planner (``soft=False``) cannot enter it until nothing else
+is left (its ``cautious`` pass), the soft one takes it when it is the shorter way. Goals are clear pixels
+either way.
+
 * frontier candidates: traversable pixels next to dark ground (within the penumbra band that the tube
   width adds), then next to penumbra, then any pixel not yet visited, each tier with a path-length penalty;
   a pixel within ``visit_radius`` m of the robot's past positions is no longer a candidate (if it is still
@@ -42,7 +49,11 @@ class NavigatingAgent(BaselinePolicy):
         replan_every: Steps between re-plans while driving.
         cautious: When no goal is reachable over clear ground, plan over the non-dark pixels with penumbra
             pixels costing ``penumbra_weight`` times more (they may hold obstacles: bumps are possible).
-        penumbra_weight: Cost of a penumbra pixel relative to a clear one (``cautious`` planning).
+        penumbra_weight: Cost of a penumbra pixel relative to a clear one (soft and ``cautious`` planning);
+            3 beat 5 on the validation levels (seeds 1 000 000-1 000 003 of every generator, 3000 steps: mean
+            T90 1777 against 1867 steps, 0.9 reached on 62 % of them against 56 %).
+        soft: Plan over every pixel not dark with the costs of :meth:`weights` (module docstring).
+        edge_weight: Cost of a clear pixel that the erosion removed (soft planning).
         **kw: :class:`BaselinePolicy` arguments.
     """
 
@@ -55,12 +66,16 @@ class NavigatingAgent(BaselinePolicy):
         visit_radius: float = 1.2,
         replan_every: int = 10,
         cautious: bool = True,
-        penumbra_weight: float = 5.0,
+        penumbra_weight: float = 3.0,
+        soft: bool = True,
+        edge_weight: float = 2.0,
         **kw: Any,
     ) -> None:
-        if not (math.isfinite(penumbra_weight) and penumbra_weight >= 1.0):
-            raise ValueError(f"penumbra_weight: must be finite and >= 1, got {penumbra_weight!r}")
+        for name, v in (("penumbra_weight", penumbra_weight), ("edge_weight", edge_weight)):
+            if not (math.isfinite(v) and v >= 1.0):
+                raise ValueError(f"{name}: must be finite and >= 1, got {v!r}")
         self.cautious, self.penumbra_weight = bool(cautious), float(penumbra_weight)
+        self.soft, self.edge_weight = bool(soft), float(edge_weight)
         if not (isinstance(margin, int) and margin >= 0):
             raise ValueError(f"margin: must be an integer >= 0, got {margin!r}")
         if not (math.isfinite(visit_radius) and visit_radius > 0):
@@ -110,22 +125,30 @@ class NavigatingAgent(BaselinePolicy):
         """Choose (or keep) the goal and set the waypoint along its shortest path."""
         mem.age = 0
         cell = view.cell
-        trav = self.traversable(view)
-        dist, pred = pl.shortest_paths(trav, cell)
-        reach = np.isfinite(dist)
-        if np.count_nonzero(reach) <= 1:  # boxed in by the erosion: plan over the plain clear pixels
-            trav = view.clear
+        if self.soft:
+            eroded = self.traversable(view)
+            weight = self.weights(view, eroded)
+            trav = np.isfinite(weight)
+            dist, pred = pl.shortest_paths(trav, cell, np.where(trav, weight, 1.0))
+            cost = self._costs(view, mem, np.isfinite(dist) & view.clear, dist)
+            cost[cell] = np.inf
+        else:
+            trav = self.traversable(view)
             dist, pred = pl.shortest_paths(trav, cell)
             reach = np.isfinite(dist)
-        cost = self._costs(view, mem, reach, dist)
-        cost[cell] = np.inf
-        if not np.isfinite(cost).any() and self.cautious:
-            # nothing over the clear ground (e.g. a map too coarse for a narrow passage): cross penumbra,
-            # at a cost, towards the same kind of goals
-            trav = ~view.dark
-            dist, pred = pl.shortest_paths(trav, cell, np.where(view.clear, 1.0, self.penumbra_weight))
-            cost = self._costs(view, mem, np.isfinite(dist), dist)
+            if np.count_nonzero(reach) <= 1:  # boxed in by the erosion: plan over the plain clear pixels
+                trav = view.clear
+                dist, pred = pl.shortest_paths(trav, cell)
+                reach = np.isfinite(dist)
+            cost = self._costs(view, mem, reach, dist)
             cost[cell] = np.inf
+            if not np.isfinite(cost).any() and self.cautious:
+                # nothing over the clear ground (e.g. a map too coarse for a narrow passage): cross
+                # penumbra, at a cost, towards the same kind of goals
+                trav = ~view.dark
+                dist, pred = pl.shortest_paths(trav, cell, np.where(view.clear, 1.0, self.penumbra_weight))
+                cost = self._costs(view, mem, np.isfinite(dist), dist)
+                cost[cell] = np.inf
         k = int(np.argmin(cost))
         best = float(cost.flat[k])
         if not math.isfinite(best):
@@ -139,8 +162,23 @@ class NavigatingAgent(BaselinePolicy):
             mem.goal_budget = int(2.0 * float(dist[mem.goal]) * steps_per_px + 60)
         path = pl.path_to(pred, trav.shape, mem.goal)
         start = np.clip(view.pos, 0, trav.shape[0] - 1e-6)
-        j = pl.line_of_sight(trav | self._disk(trav.shape[0], view.pos, 1.0), start, path)
+        sight = (eroded if self.soft else trav) | self._disk(trav.shape[0], view.pos, 1.0)
+        if self.soft:  # a straight line may also follow the path's own pixels (a corridor in penumbra)
+            on_path = np.zeros_like(sight)
+            on_path[path[:, 0], path[:, 1]] = True
+            sight |= on_path
+        j = pl.line_of_sight(sight, start, path)
         mem.waypoint = path[j].astype(np.float64) + 0.5
+
+    def weights(self, view: View, eroded: np.ndarray | None = None) -> np.ndarray:
+        """``(m, m)`` cost per pixel of the soft planner: 1 on the traversable pixels (clear, eroded; pass
+        them as ``eroded`` if already computed), ``edge_weight`` on the other clear pixels,
+        ``penumbra_weight`` on penumbra, ``inf`` on dark ground."""
+        w = np.full(view.clear.shape, np.inf)
+        w[view.penumbra] = self.penumbra_weight
+        w[view.clear] = self.edge_weight
+        w[self.traversable(view) if eroded is None else eroded] = 1.0
+        return w
 
 
 class FrontierAgent(NavigatingAgent):

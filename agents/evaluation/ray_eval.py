@@ -102,7 +102,8 @@ def build_policy(
     spec: PolicySpec, env_id: str, env_kwargs: Mapping[str, Any] | None = None, seed: int | None = None
 ) -> Any:
     """The policy of ``spec``: ``make_baseline(spec, env, seed=seed)`` for a baseline name, else
-    ``PPO.load(spec)`` (``seed`` unused).
+    ``PPO.load(spec)`` as a policy of the continuous environment (:func:`.models.as_policy`; ``seed``
+    unused).
 
     The environment (made only for its spaces) is closed before returning.
     """
@@ -121,7 +122,7 @@ def build_policy(
         raise ValueError(f"spec: no baseline named {spec!r} and no model file at that path")
     from stable_baselines3 import PPO
 
-    return PPO.load(spec, device="cpu")
+    return models.as_policy(PPO.load(spec, device="cpu"))
 
 
 def evaluate_one(

@@ -10,7 +10,7 @@ Torch and stable-baselines3 are imported only by :func:`load_ppo`.
 
 >>> DEFAULT_ENV, PRETRAINED.name
 ('digslam/DigCoverage-v0', 'ppo_digcoverage.zip')
->>> sorted(model_env_kwargs())  # the sidecar's keywords, less the training-only ``fixed_world``
+>>> sorted(model_env_kwargs())  # the sidecar's keywords, less the training-only ones (``fixed_world``)
 ['crop', 'map_size']
 """
 
@@ -28,6 +28,10 @@ PRETRAINED = DATA / "ppo_digcoverage.zip"
 DEFAULT_ENV = "digslam/DigCoverage-v0"
 
 
+#: Environment keywords of a training run that are no part of what the model sees.
+TRAINING_ONLY = ("fixed_world", "max_episode_steps", "render_mode")
+
+
 class ModelError(ValueError):
     """A saved model or its sidecar cannot be used: missing, not a PPO model, trained on other observations,
     or a damaged sidecar. The message is one line naming the file."""
@@ -39,28 +43,45 @@ def _first_line(exc: BaseException) -> str:
 
 
 def model_env_kwargs(model: str | Path | None = None) -> dict[str, Any]:
-    """Environment keywords of a saved model (None: :data:`PRETRAINED`), read from its ``.json`` sidecar
-    (``{}`` if there is none); ``fixed_world``, a training choice that is no part of the observation, is
-    left out.
+    """Environment keywords of a saved model (None: :data:`PRETRAINED`), read from its ``.json`` sidecar,
+    else from the ``config.json`` of the ``digslam train`` run that holds it (its folder, or one up for a
+    checkpoint), else ``{}``; the training choices of :data:`TRAINING_ONLY`, no part of the observation,
+    are left out (each command sets its own episode length).
 
     Raises:
         ModelError: the sidecar is not one written by ``digslam train``.
     """
-    side = Path(model if model is not None else PRETRAINED).with_suffix(".json")
-    if not side.is_file():
-        return {}
+    path = Path(model if model is not None else PRETRAINED)
+    side = path.with_suffix(".json")
+    if not side.is_file():  # a model of a `digslam train` run without its sidecar, or a checkpoint
+        runs = [d / "config.json" for d in (path.parent, path.parent.parent)]
+        side = next((c for c in runs if c.is_file()), side)
+        if not side.is_file():
+            return {}
     try:
         kw = dict(json.loads(side.read_text()).get("env_kwargs", {}))
     except (OSError, ValueError, AttributeError, TypeError) as exc:
         raise ModelError(f"{side}: not a model sidecar written by `digslam train` ({_first_line(exc)}); "
                          "fix or delete it") from None  # fmt: skip
-    kw.pop("fixed_world", None)
+    for key in TRAINING_ONLY:
+        kw.pop(key, None)
     return kw
+
+
+def as_policy(model: Any) -> Any:
+    """``model`` as a policy of the continuous environment: a model trained on discrete turn-or-go actions
+    (``actions = "turn_go"``) wrapped in :class:`~.wrappers.TurnGoPolicy`, any other as it is."""
+    if getattr(model.action_space, "n", None) is None:
+        return model
+    from digslam.agents.learning.wrappers import TurnGoPolicy
+
+    return TurnGoPolicy(model)
 
 
 def load_ppo(path: str | Path, env: Any, opt: str = "model") -> Any:
     """The saved PPO model at ``path`` (on the CPU, torch on one thread), checked against ``env``'s
-    observation space.
+    observation space; a model trained on discrete turn-or-go actions (``actions = "turn_go"``) comes
+    wrapped in :class:`~.wrappers.TurnGoPolicy`, so that it acts in the continuous environment.
 
     Args:
         path: A ``.zip`` saved by ``digslam train`` (or SB3's ``PPO.save``).
@@ -89,6 +110,10 @@ def load_ppo(path: str | Path, env: Any, opt: str = "model") -> Any:
     except Exception as exc:  # noqa: BLE001 - any failure to read the file is the file's
         raise ModelError(f"{opt} {path}: not a PPO model saved by `digslam train` "
                          f"({type(exc).__name__}: {_first_line(exc)})") from None  # fmt: skip
+    try:
+        model = as_policy(model)
+    except ValueError as exc:
+        raise ModelError(f"{opt} {path}: {_first_line(exc)}") from None
     if model.observation_space != env.observation_space:
         raise ModelError(f"{opt} {path}: trained on observations {model.observation_space}, but the "
                          f"environment gives {env.observation_space}; pass the environment keywords it was "
@@ -96,4 +121,5 @@ def load_ppo(path: str | Path, env: Any, opt: str = "model") -> Any:
     return model
 
 
-__all__ = ["DATA", "DEFAULT_ENV", "PRETRAINED", "ModelError", "load_ppo", "model_env_kwargs"]
+__all__ = ["DATA", "DEFAULT_ENV", "PRETRAINED", "TRAINING_ONLY", "ModelError", "as_policy", "load_ppo",
+           "model_env_kwargs"]  # fmt: skip

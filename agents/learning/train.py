@@ -21,6 +21,7 @@ ValueError: TrainConfig: unknown key(s) ['n_env']; known: ...
 from __future__ import annotations
 
 import json
+import math
 import os
 import signal
 import threading
@@ -32,6 +33,7 @@ from typing import Any
 
 import gymnasium as gym
 
+from digslam.agents.learning.wrappers import ACTION_MODES, wrap_training_env
 from digslam.envs.splits import VALIDATION, check_not_test
 from digslam.observer.core.config import Config, config_dataclass
 
@@ -71,6 +73,11 @@ class TrainConfig(Config):
         torch_threads: Torch threads per process.
         progress_bar: Show SB3's progress bar.
         verbose: SB3 verbosity.
+        actions: ``"continuous"`` (the env's ``(v, ω)`` box) or ``"turn_go"`` (discrete drive-straight or
+            turn-in-place actions, :class:`~.wrappers.TurnGoActions`: the deterministic policy is then one
+            of the actions it was trained on).
+        tube_penalty: Reward units per metre of growth of the pose box's widest side
+            (:class:`~.wrappers.TubePenalty`; 0: none).
     """
 
     env_id: str = "digslam/DigCoverage-v0"
@@ -94,6 +101,8 @@ class TrainConfig(Config):
     torch_threads: int = 1
     progress_bar: bool = True
     verbose: int = 0
+    actions: str = "continuous"
+    tube_penalty: float = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -111,6 +120,10 @@ class TrainConfig(Config):
         for name in ("eval_freq", "checkpoint_freq", "ent_coef", "seed", "eval_seed"):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name}: must be >= 0, got {getattr(self, name)!r}")
+        if self.actions not in ACTION_MODES:
+            raise ValueError(f"actions: must be one of {ACTION_MODES}, got {self.actions!r}")
+        if not (math.isfinite(self.tube_penalty) and self.tube_penalty >= 0):
+            raise ValueError(f"tube_penalty: must be finite and >= 0, got {self.tube_penalty!r}")
         if not 0.0 < self.learning_rate < 1.0:
             raise ValueError(f"learning_rate: must be in (0, 1), got {self.learning_rate!r}")
         if not 0.0 < self.gamma <= 1.0:
@@ -208,12 +221,15 @@ class EnvFactory:
         env_kwargs: ``gym.make`` keyword arguments.
         torch_threads: Torch threads in the worker.
         seeds: If given, unseeded resets cycle through these seeds (held-out evaluation maps).
+        actions, tube_penalty: The training wrappers (:func:`~.wrappers.wrap_training_env`).
     """
 
     env_id: str
     env_kwargs: Mapping[str, Any] = field(default_factory=dict)
     torch_threads: int = 1
     seeds: tuple[int, ...] | None = None
+    actions: str = "continuous"
+    tube_penalty: float = 0.0
 
     def __call__(self) -> Any:
         from stable_baselines3.common.monitor import Monitor
@@ -221,6 +237,7 @@ class EnvFactory:
         pin_threads(self.torch_threads)
         env_id = self.env_id if ":" in self.env_id else f"digslam.envs:{self.env_id}"
         env = gym.make(env_id, **dict(self.env_kwargs))
+        env = wrap_training_env(env, self.actions, self.tube_penalty)
         if self.seeds:
             env = SeedCycle(env, self.seeds)
         return Monitor(env)
@@ -284,7 +301,9 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = N
     signal never lands inside a kernel being compiled or a half-done update.
 
     ``out_dir`` also gets ``config.json``, ``checkpoints/``, ``tb/`` (TensorBoard), and with evaluation
-    ``best_model.zip`` and ``eval/evaluations.npz`` (held-out maps ``cfg.eval_seeds()``).
+    ``best_model.zip`` and ``eval/evaluations.npz`` (held-out maps ``cfg.eval_seeds()``). Every model
+    saved here has its sidecar ``<model>.json`` (:func:`write_sidecar`); a checkpoint's keywords are read
+    from ``config.json`` one folder up.
     """
     from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
 
@@ -311,7 +330,10 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = N
     import contextlib
 
     with worker_guard if worker_guard is not None else contextlib.nullcontext():
-        env = make_vec_env(EnvFactory(cfg.env_id, cfg.env_kwargs, cfg.torch_threads), cfg.n_envs, cfg.seed)
+        factory = EnvFactory(
+            cfg.env_id, cfg.env_kwargs, cfg.torch_threads, None, cfg.actions, cfg.tube_penalty
+        )
+        env = make_vec_env(factory, cfg.n_envs, cfg.seed)
     callbacks = list(callbacks)
     eval_env = None
     try:
@@ -320,7 +342,7 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = N
             callbacks.append(CheckpointCallback(every, str(out / "checkpoints"), name_prefix="ppo"))
         if cfg.eval_freq:
             seeds = cfg.eval_seeds()
-            held_out = EnvFactory(cfg.env_id, cfg.env_kwargs, cfg.torch_threads, seeds)
+            held_out = EnvFactory(cfg.env_id, cfg.env_kwargs, cfg.torch_threads, seeds, cfg.actions)
             eval_env = make_vec_env(held_out, 1, seeds[0])
             callbacks.append(
                 EvalCallback(
@@ -350,10 +372,12 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = N
                     signal.signal(signal.SIGINT, old)
             if interrupted:
                 path = out / "interrupted_model.zip"
-                _save(model, path)
+                _save(model, path, cfg)
                 raise TrainingInterrupted(path, int(model.num_timesteps)) from None
         path = out / "final_model.zip"
-        _save(model, path)
+        _save(model, path, cfg)
+        if (out / "best_model.zip").is_file():
+            write_sidecar(out / "best_model.zip", cfg)
     finally:
         env.close()
         if eval_env is not None:
@@ -361,14 +385,26 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = N
     return path
 
 
-def _save(model: Any, path: Path) -> None:
-    """``model.save`` to a scratch file, then renamed: an interrupted save leaves no half-written model."""
+def write_sidecar(path: Path, cfg: TrainConfig) -> Path:
+    """Write ``<model>.json`` beside the model ``path``: the environment id and keywords it was trained
+    with, which ``demo``, ``evaluate``, ``record`` and ``benchmark`` read
+    (:func:`~digslam.agents.learning.models.model_env_kwargs`)."""
+    side = path.with_suffix(".json")
+    meta = {"env_id": cfg.env_id, "env_kwargs": dict(cfg.env_kwargs), "actions": cfg.actions}
+    side.write_text(json.dumps(meta, indent=2))
+    return side
+
+
+def _save(model: Any, path: Path, cfg: TrainConfig) -> None:
+    """``model.save`` to a scratch file, then renamed (an interrupted save leaves no half-written model),
+    and its sidecar (:func:`write_sidecar`)."""
     tmp = path.with_name(f".{path.stem}.part{os.getpid()}.zip")
     try:
         model.save(tmp)
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
+    write_sidecar(path, cfg)
 
 
 def _has_progress() -> bool:
@@ -381,4 +417,4 @@ def _has_progress() -> bool:
 
 
 __all__ = ["DEFAULT_CONFIG", "EnvFactory", "SeedCycle", "TrainConfig", "TrainingInterrupted", "build_model",
-           "make_vec_env", "parse_value", "pin_threads", "train"]  # fmt: skip
+           "make_vec_env", "parse_value", "pin_threads", "train", "write_sidecar"]  # fmt: skip

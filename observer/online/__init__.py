@@ -3,13 +3,22 @@
 Lives here: :mod:`.observer` (``OnlineDigSlam``, ``OnlineConfig``), :mod:`.window` (the dig map kept in a
 sliding window) and its kernels: :mod:`.dig_jit` (digging, the cone windows and the named tuples the
 kernels take: ``GridFrame``, ``CellSets``, ``PoseBox``, ``StepRecord``...), :mod:`.mark_jit`
-(marking the explored zone), :mod:`.pose_jit` (pose prediction and contraction) and :mod:`.step_jit` (one
-whole filter step, q-relaxed, Sec. 6.3).
+(marking the explored zone), :mod:`.pose_jit` (pose prediction and contraction), :mod:`.cones_jit` (the
+directional impact contractor: each echo's cone meets ``comp M⁻``) and :mod:`.step_jit` (one whole filter
+step, q-relaxed, Sec. 6.3).
 
 May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.slam` (records, grid, dig map),
 :mod:`digslam.observer.thick` (the thick-set codes); numpy, numba.
 """
 
+from .cones_jit import (
+    ANGLE_PAD,
+    MIN_SLICE,
+    box_feasible,
+    box_in_cone,
+    cone_cell_ok,
+    contract_cones,
+)
 from .dig_jit import (
     CellAxes,
     CellSets,
@@ -62,6 +71,8 @@ from .window import (
 )
 
 __all__ = [
+    "ANGLE_PAD",
+    "MIN_SLICE",
     "CellAxes",
     "CellSets",
     "GridFrame",
@@ -72,11 +83,15 @@ __all__ = [
     "SectorBatch",
     "StepRecord",
     "WindowDigMap",
+    "box_feasible",
+    "box_in_cone",
     "box_ok",
     "cell_size",
     "clearance_cells",
     "cone_window",
+    "cone_cell_ok",
     "contract",
+    "contract_cones",
     "cos_sin",
     "dig_and_mark",
     "dig_and_mark_q",

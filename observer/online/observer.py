@@ -11,7 +11,8 @@ Each :meth:`OnlineDigSlam.update` takes the next single-step record and
    :func:`.pose_jit.rotate`), each correctly rounded operation stepped one ulp outward, ``cos``/``sin``
    widened by more than :data:`~.rounding.LIBM_ULPS`;
 2. contracts the box with the impacts ``dist(x_k, comp M⁻) <= y⁺`` (Eq. 6.22) on a window
-   (:func:`.pose_jit.contract`);
+   (:func:`.pose_jit.contract`), then (``cones``, the default) with their directional form, each echo's
+   cone meeting ``comp M⁻`` (:func:`.cones_jit.contract_cones`);
 3. digs ``M⁻ := M⁻ ∪ g⁻¹_{[x_k]}(Z⁻)`` (Eq. 6.21) and grows the explored zone: certainly sensed =
    dug, possibly sensed = not proved outside every sensed sector, one compiled pass over the cells in
    sensor reach (:func:`.mark_jit.dig_and_mark`);
@@ -92,6 +93,8 @@ class OnlineConfig(Config):
     Attributes:
         smoothing_window: fixed-lag backward smoothing over the last ``W`` steps (0 = off).
         impacts: apply the impact contractor (Eq. 6.22).
+        cones: with ``impacts``, also its directional form: each echo's cone meets ``comp M⁻``
+            (:mod:`.cones_jit`), which bounds the position on both sides between walls.
         q: the q-relaxed mode (thesis §2.6.2): at most ``q`` of the range readings of ONE step are outliers
             (their intervals may miss the truth; which ones is unknown). 0 (default): none, every claim as
             in Algorithm 6.3. See the module docstring.
@@ -99,11 +102,14 @@ class OnlineConfig(Config):
 
     smoothing_window: int = 0
     impacts: bool = True
+    cones: bool = True
     q: int = 0
 
     def __post_init__(self) -> None:
         check_int("smoothing_window", self.smoothing_window, 0)
-        check(isinstance(self.impacts, bool | np.bool_), "impacts", f"must be a bool, got {self.impacts!r}")
+        for name in ("impacts", "cones"):
+            v = getattr(self, name)
+            check(isinstance(v, bool | np.bool_), name, f"must be a bool, got {v!r}")
         check_int("q", self.q, 0, " (outliers allowed per step)")
 
 
@@ -148,7 +154,8 @@ class OnlineDigSlam:
             raise ValueError(f"config: expected an OnlineConfig, got {type(config).__name__}")
         self.grid, self.config = grid, config or OnlineConfig()
         self._ring: deque = deque(maxlen=self.config.smoothing_window + 1)
-        self._impacts, self._q = bool(self.config.impacts), int(self.config.q)
+        impacts = self.config.impacts
+        self._impacts, self._q = (2 if self.config.cones else 1) if impacts else 0, int(self.config.q)
         self._blank()
 
     def _blank(self) -> None:

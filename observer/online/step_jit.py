@@ -7,7 +7,9 @@ Python, with the same arguments and the same results:
    the compass);
 2. with ``impacts``, :func:`.pose_jit.impact_bound` then :func:`.pose_jit.contract` (Eq. 6.22), skipped
    (box unchanged) when the box leaves the grid's frame or no sensor echoed, as
-   :meth:`.window.WindowDigMap.contract_box` does;
+   :meth:`.window.WindowDigMap.contract_box` does; with ``impacts = 2`` also the directional form, each
+   echo's cone meeting ``comp M⁻`` (:func:`.cones_jit.contract_cones`), on a box wider than
+   :data:`CONE_MIN_WIDTH`;
 3. :func:`.mark_jit.dig_and_mark`: digs ``M⁻`` (Eq. 6.21) and grows the explored zone (Eq. B.5).
 
 :func:`filter_step_q` takes ``q``, the number of outliers allowed among the step's range readings (thesis
@@ -47,16 +49,21 @@ import math
 import numpy as np
 
 from digslam.observer.core.scalar_jit import njit
+from digslam.observer.online.cones_jit import contract_cones
 from digslam.observer.online.dig_jit import CellSets, GridFrame, PoseBox, StepRecord, in_frame
 from digslam.observer.online.mark_jit import dig_and_mark_q
 from digslam.observer.online.pose_jit import contract, impact_bound_q, predict
 
-__all__ = ["filter_step", "filter_step_flat", "filter_step_q"]
+__all__ = ["CONE_MIN_WIDTH", "filter_step", "filter_step_flat", "filter_step_q"]
+
+#: Pose boxes at most this wide (m) skip the cone contractor (it seldom cuts them: ``M⁻`` is set back from
+#: the walls by about a cell); skipping a contractor never makes a claim false.
+CONE_MIN_WIDTH = 0.15
 
 
 @njit
 def filter_step_q(cells: CellSets, grid: GridFrame, step: StepRecord, pose_lo: np.ndarray,
-                  pose_hi: np.ndarray, heading: np.ndarray, impacts: bool, q: int
+                  pose_hi: np.ndarray, heading: np.ndarray, impacts: int, q: int
                   ) -> tuple[int, int, int, int, int, tuple[float, float, float, float]]:  # fmt: skip
     """Predict, contract and measure one step (see the module docstring), robust to ``q`` outliers.
 
@@ -68,7 +75,8 @@ def filter_step_q(cells: CellSets, grid: GridFrame, step: StepRecord, pose_lo: n
         pose_lo, pose_hi, heading: ``(2,)`` the pose box ``[x⁻, y⁻]``, ``[x⁺, y⁺]`` and the heading interval
             ``[ψ⁻, ψ⁺]`` at the previous step, overwritten with the new ones when ``code`` is 0 (left as
             they are otherwise).
-        impacts: apply Eq. 6.22.
+        impacts: 0: no impact contractor; 1 (or True): Eq. 6.22; 2: Eq. 6.22 then each echo's cone
+            (:func:`.cones_jit.contract_cones`).
         q: at most ``q`` of this step's range readings are outliers (0: none): the impact radius is the
             q-relaxed :func:`.pose_jit.impact_bound_q` and a cell is dug where ``q + 1`` readings prove it
             free (:func:`.mark_jit.dig_and_mark_q`).
@@ -89,6 +97,10 @@ def filter_step_q(cells: CellSets, grid: GridFrame, step: StepRecord, pose_lo: n
         r_hi = impact_bound_q(step.no_echo, step.ranges, q)
         if math.isfinite(r_hi) and in_frame(grid, x0, y0, x1, y1):
             x0, y0, x1, y1 = contract(cells.free, grid, x0, y0, x1, y1, r_hi)
+            if impacts >= 2 and x0 <= x1 and y0 <= y1 and max(x1 - x0, y1 - y0) > CONE_MIN_WIDTH:
+                x0, y0, x1, y1 = contract_cones(cells.free, grid, x0, y0, x1, y1, box.psi_lo,
+                                                box.psi_hi, step.alpha, step.gamma, step.ranges,
+                                                step.no_echo, q)  # fmt: skip
     if not (x0 <= x1 and y0 <= y1):
         return 1, 0, 0, 0, 0, nan
     lo[0], lo[1], hi[0], hi[1] = x0, y0, x1, y1
@@ -100,7 +112,7 @@ def filter_step_q(cells: CellSets, grid: GridFrame, step: StepRecord, pose_lo: n
 
 @njit
 def filter_step_flat(cells: tuple, grid: tuple, step: tuple, pose_lo: np.ndarray, pose_hi: np.ndarray,
-                     heading: np.ndarray, impacts: bool, q: int
+                     heading: np.ndarray, impacts: int, q: int
                      ) -> tuple[int, int, int, int, int, tuple[float, float, float, float]]:  # fmt: skip
     """:func:`filter_step_q` with ``cells``, ``grid`` and ``step`` the plain tuples of the fields of a
     :class:`.dig_jit.CellSets`, a :class:`.dig_jit.GridFrame` and a :class:`.dig_jit.StepRecord` (all 11
@@ -111,7 +123,7 @@ def filter_step_flat(cells: tuple, grid: tuple, step: tuple, pose_lo: np.ndarray
 
 @njit
 def filter_step(cells: CellSets, grid: GridFrame, step: StepRecord, pose_lo: np.ndarray, pose_hi: np.ndarray,
-                heading: np.ndarray, impacts: bool
+                heading: np.ndarray, impacts: int
                 ) -> tuple[int, int, int, int, int, tuple[float, float, float, float]]:  # fmt: skip
     """:func:`filter_step_q` with ``q = 0`` (no outlier: every reading's interval contains the truth)."""
     return filter_step_q(cells, grid, step, pose_lo, pose_hi, heading, impacts, 0)

@@ -113,7 +113,15 @@ def test_frontier_goes_to_the_nearest_frontier_through_the_door() -> None:
     dark = np.zeros_like(clear)
     dark[4:32, 32:] = True  # unexplored ground only on the right
     obs = _obs(clear, (10.5, 8.5), heading=0.0, dark=dark)
-    agent = FrontierAgent(BOX, visit_radius=0.5, span=36.0, penumbra_penalty=100.0, unvisited_penalty=200.0)
+    # the wall is penumbra here: crossing it (2 pixels at 50 each) costs more than the detour by the door
+    agent = FrontierAgent(
+        BOX,
+        visit_radius=0.5,
+        span=36.0,
+        penumbra_penalty=100.0,
+        unvisited_penalty=200.0,
+        penumbra_weight=50.0,
+    )
     a, _ = agent.predict(obs)
     mem = agent._mem[0]
     assert mem.goal is not None and mem.goal[1] >= 28  # next to the dark ground
@@ -241,3 +249,24 @@ def test_module_doctests(module: str) -> None:
     mod = importlib.import_module(f"digslam.agents.{module}")
     res = doctest.testmod(mod, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
     assert res.attempted > 0 and res.failed == 0
+
+
+def test_soft_planner_takes_a_corridor_narrower_than_the_erosion() -> None:
+    """Two rooms joined by a 2-pixel corridor: eroded by the margin it is closed, so the plain planner only
+    sees the first room's unvisited ground; the soft planner crosses it (clear, not eroded, costs more)
+    towards the frontier beyond the second room."""
+    clear = np.zeros((36, 36), bool)
+    clear[6:30, 4:15] = clear[6:30, 21:32] = True
+    clear[17:19, 15:21] = True  # the corridor
+    dark = np.zeros_like(clear)
+    dark[:, 33:] = True  # unexplored beyond the second room; the rest is penumbra
+    obs = _obs(clear, (18.0, 8.5), heading=0.0, dark=dark)
+    goals = {}
+    for soft in (True, False):
+        agent = FrontierAgent(
+            BOX, visit_radius=0.5, span=36.0, soft=soft, penumbra_penalty=100.0, unvisited_penalty=200.0
+        )
+        agent.predict(obs)
+        goals[soft] = agent._mem[0].goal
+    assert goals[True] is not None and goals[True][1] >= 28
+    assert goals[False] is not None and goals[False][1] < 15

@@ -15,6 +15,7 @@ import gymnasium as gym  # noqa: E402
 from gymnasium import spaces  # noqa: E402
 
 from digslam.agents.learning.extractor import MapStateExtractor, conv_plan  # noqa: E402
+from digslam.agents.learning.models import TRAINING_ONLY, model_env_kwargs  # noqa: E402
 from digslam.agents.learning.train import DEFAULT_CONFIG, EnvFactory, TrainConfig, parse_value  # noqa: E402
 
 
@@ -134,7 +135,6 @@ def test_ppo_with_the_extractor_predicts_on_the_env() -> None:
     vec.close()
 
 
-@pytest.mark.expensive
 def test_train_end_to_end_gives_a_loadable_model(tmp_path) -> None:  # type: ignore[no-untyped-def]
     from stable_baselines3 import PPO
 
@@ -155,3 +155,72 @@ def test_train_end_to_end_gives_a_loadable_model(tmp_path) -> None:  # type: ign
     action, _ = model.predict(obs, deterministic=True)
     assert env.action_space.contains(action)
     assert model.num_timesteps >= 256
+    # the model goes through every command with the environment it was trained on (its sidecar)
+    side = json.loads(path.with_suffix(".json").read_text())
+    assert side["env_kwargs"] == dict(cfg.env_kwargs) and side["env_id"] == cfg.env_id
+    from digslam.agents.cli import main as cli
+
+    out = tmp_path / "cli"
+    assert cli.main(["demo", "--model", str(path), "--steps", "5", "--out", str(out / "demo")]) == 0
+    assert cli.main(["evaluate", "--model", str(path), "--agents", "ppo", "--maps", "1", "--steps", "5",
+                     "--out", str(out / "evaluate")]) == 0  # fmt: skip
+    assert cli.main(["record", "--agent", "ppo", "--model", str(path), "--steps", "5",
+                     "--out", str(out / "ep.npz")]) == 0  # fmt: skip
+    # a checkpoint has no sidecar: the run's config.json, one folder up, gives its keywords
+    ckpt = next((tmp_path / "checkpoints").glob("*.zip"))
+    assert model_env_kwargs(ckpt) == {k: v for k, v in cfg.env_kwargs.items() if k not in TRAINING_ONLY}
+
+
+def test_turn_go_actions_and_tube_penalty() -> None:
+    from digslam.agents.learning.wrappers import TURN_GO, TubePenalty, TurnGoActions, wrap_training_env
+
+    base = gym.make("digslam/DigCoverage-v0", map_size=36)
+    env = TurnGoActions(base)
+    assert env.action_space == spaces.Discrete(len(TURN_GO))
+    assert all(base.action_space.contains(a) for a in TURN_GO)
+    for a in TURN_GO:  # drive straight or turn in place, never both
+        assert a[0] == 0.0 or a[1] == 0.0
+    with pytest.raises(ValueError, match="action"):
+        env.action(len(TURN_GO))
+    with pytest.raises(ValueError, match="actions"):
+        wrap_training_env(base, "arcs")
+    with pytest.raises(ValueError, match="tube_penalty"):
+        TrainConfig(tube_penalty=-1.0)
+    # the penalty is the growth of the widest side of the pose box, times the weight
+    plain, pen = gym.make("digslam/DigCoverage-v0", map_size=36), TubePenalty(
+        gym.make("digslam/DigCoverage-v0", map_size=36), weight=100.0
+    )
+    plain.reset(seed=4)
+    pen.reset(seed=4)
+    tube0, total = 0.0, 0.0
+    for _ in range(30):
+        _, r0, *_, info = plain.step(TURN_GO[2])
+        _, r1, *_ = pen.step(TURN_GO[2])
+        box = np.asarray(info["pose_box"])
+        tube = float(np.max(box[1] - box[0]))
+        assert r1 == pytest.approx(r0 - 100.0 * max(tube - tube0, 0.0)) or tube0 == 0.0
+        total += r0 - r1
+        tube0 = tube
+    assert total > 0  # turning in place grows the box (odometry noise): penalised
+
+
+def test_turn_go_model_acts_in_the_continuous_env(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """A model trained on turn-or-go actions loads as a continuous-action policy (``TurnGoPolicy``)."""
+    from digslam.agents.learning.models import load_ppo
+    from digslam.agents.learning.train import EnvFactory, build_model, make_vec_env
+    from digslam.agents.learning.wrappers import TURN_GO, TurnGoPolicy
+
+    cfg = TrainConfig(n_envs=1, n_steps=32, batch_size=32, features_dim=16, actions="turn_go",
+                      env_kwargs={"map_size": 36, "max_episode_steps": 40})  # fmt: skip
+    vec = make_vec_env(EnvFactory(cfg.env_id, cfg.env_kwargs, actions="turn_go"), 1, 0)
+    model = build_model(cfg, vec)
+    model.learn(32)
+    path = tmp_path / "m.zip"
+    model.save(path)
+    vec.close()
+    env = gym.make("digslam/DigCoverage-v0", map_size=36)
+    policy = load_ppo(path, env)
+    assert isinstance(policy, TurnGoPolicy)
+    obs, _ = env.reset(seed=2)
+    action, _ = policy.predict(obs, deterministic=True)
+    assert env.action_space.contains(action) and any(np.array_equal(action, a) for a in TURN_GO)

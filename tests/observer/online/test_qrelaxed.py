@@ -68,12 +68,16 @@ def _corrupt(rec: MissionRecord, k: int, mode: str, shift: float = 0.3) -> Missi
 # --------------------------------------------------------------------------- q = 0 is the former filter
 @pytest.mark.parametrize("seed", sorted(OLD_DIGESTS))
 def test_q0_reproduces_the_former_filter_bit_for_bit(seed: int) -> None:
+    """Without the cone contractor (``cones=False``, which came later), q = 0 is the former filter."""
     recs, poses = square_room_records(seed, 300)
-    f = run(recs)
+    f = run(recs, OnlineConfig(cones=False))
     assert digest(f) == OLD_DIGESTS[seed]
-    assert digest(run(recs, OnlineConfig(q=0))) == OLD_DIGESTS[seed]
-    assert digest(run(recs, OnlineConfig(smoothing_window=5))) == OLD_DIGESTS[seed]
+    assert digest(run(recs, OnlineConfig(q=0, cones=False))) == OLD_DIGESTS[seed]
+    assert digest(run(recs, OnlineConfig(smoothing_window=5, cones=False))) == OLD_DIGESTS[seed]
     assert f.consistent and f.pose_lo[0] <= poses[-1, 0] <= f.pose_hi[0] and _room_cells_ok(f.dig.free)
+    g = run(recs)  # with the cones: still consistent and sound
+    assert g.consistent and np.all(g.pose_lo <= poses[-1, :2]) and np.all(poses[-1, :2] <= g.pose_hi)
+    assert _room_cells_ok(g.dig.free)
 
 
 def test_impact_bound_q_is_the_q_plus_first_smallest_echo() -> None:
