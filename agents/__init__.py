@@ -3,9 +3,11 @@
 Names are imported on first use, so ``import digslam.agents`` needs neither torch nor stable-baselines3
 (those are imported inside the functions that train or load a learned policy).
 
-Folders: :mod:`~digslam.agents.baselines` (heuristic agents), :mod:`~digslam.agents.learning` (training,
-sweeps, the shipped model), :mod:`~digslam.agents.evaluation` (evaluation, pictures) and
-:mod:`~digslam.agents.cli` (the command line, the only place that wires argparse). The evaluation function
+Folders: :mod:`~digslam.agents.baselines` (heuristic agents), :mod:`~digslam.agents.goals` (the
+goal-selection env ``digslam/DigCoverageGoals-v0``: candidate goals driven by the frontier agent's loop,
+registered when that folder is imported), :mod:`~digslam.agents.learning` (training, sweeps, the shipped
+model), :mod:`~digslam.agents.evaluation` (evaluation, pictures) and :mod:`~digslam.agents.cli` (the command
+line, the only place that wires argparse). The evaluation function
 is exported as :func:`evaluate_agents` (``digslam.agents.evaluation.evaluate`` is its module).
 """
 
@@ -38,6 +40,8 @@ _LAZY = {
     "RandomAgent": "baselines",
     "UncertaintyAwareFrontier": "baselines",
     "make_baseline": "baselines",
+    "FirstCandidatePolicy": "goals",
+    "GoalSelectionEnv": "goals",
     "EvalResult": "evaluation.evaluate",
     "coverage_figure": "evaluation.evaluate",
     "evaluate_agents": "evaluation.evaluate",

@@ -37,6 +37,7 @@ ALLOWED: dict[str, set[str]] = {
     "agents.learning": {"observer.core", "envs", "agents.baselines", "agents.evaluation"},
     "agents.evaluation": {"observer.core", "observer.thick", "envs", "envs.sim", "envs.explore",
                           "envs.dig_coverage", "agents.baselines", "agents.learning"},
+    "agents.goals": {"envs", "agents.baselines"},
 }  # fmt: skip
 FOLDERS = sorted(m.name for m in MODS.values() if m.is_package and m.name.count(".") == 1)
 

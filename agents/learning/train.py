@@ -78,6 +78,11 @@ class TrainConfig(Config):
             of the actions it was trained on).
         tube_penalty: Reward units per metre of growth of the pose box's widest side
             (:class:`~.wrappers.TubePenalty`; 0: none).
+        algo: ``"ppo"`` (stable-baselines3) or ``"maskable_ppo"`` (sb3-contrib's ``MaskablePPO``, for the
+            goal-selection envs of :mod:`digslam.agents.goals`, whose invalid candidates are masked).
+        heuristic_prior: With ``maskable_ppo``: the initial logit of candidate ``k`` is
+            ``heuristic_prior * (1 - k / K)`` (the candidates come sorted by the frontier heuristic's cost,
+            so the untrained policy already prefers the heuristic's pick; 0: uniform).
     """
 
     env_id: str = "digslam/DigCoverage-v0"
@@ -103,6 +108,8 @@ class TrainConfig(Config):
     verbose: int = 0
     actions: str = "continuous"
     tube_penalty: float = 0.0
+    algo: str = "ppo"
+    heuristic_prior: float = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -122,6 +129,10 @@ class TrainConfig(Config):
                 raise ValueError(f"{name}: must be >= 0, got {getattr(self, name)!r}")
         if self.actions not in ACTION_MODES:
             raise ValueError(f"actions: must be one of {ACTION_MODES}, got {self.actions!r}")
+        if self.algo not in ALGOS:
+            raise ValueError(f"algo: must be one of {ALGOS}, got {self.algo!r}")
+        if not (math.isfinite(self.heuristic_prior) and self.heuristic_prior >= 0):
+            raise ValueError(f"heuristic_prior: must be finite and >= 0, got {self.heuristic_prior!r}")
         if not (math.isfinite(self.tube_penalty) and self.tube_penalty >= 0):
             raise ValueError(f"tube_penalty: must be finite and >= 0, got {self.tube_penalty!r}")
         if not 0.0 < self.learning_rate < 1.0:
@@ -235,7 +246,7 @@ class EnvFactory:
         from stable_baselines3.common.monitor import Monitor
 
         pin_threads(self.torch_threads)
-        env_id = self.env_id if ":" in self.env_id else f"digslam.envs:{self.env_id}"
+        env_id = self.env_id if ":" in self.env_id else f"{env_module(self.env_id)}:{self.env_id}"
         env = gym.make(env_id, **dict(self.env_kwargs))
         env = wrap_training_env(env, self.actions, self.tube_penalty)
         if self.seeds:
@@ -254,8 +265,52 @@ def make_vec_env(factory: EnvFactory, n: int, seed: int) -> Any:
     return vec
 
 
+#: The learning algorithms of :class:`TrainConfig` (``algo``).
+ALGOS = ("ppo", "maskable_ppo")
+
+
+def env_module(env_id: str) -> str:
+    """The module that registers ``env_id`` (``gym.make("<module>:<id>")`` imports it first in a fresh
+    worker): :mod:`digslam.agents.goals` for the goal-selection ids, else :mod:`digslam.envs`."""
+    return "digslam.agents.goals" if env_id.split("/")[-1].startswith("DigCoverageGoals") else "digslam.envs"
+
+
+def build_maskable(cfg: TrainConfig, env: Any, tensorboard_log: str | None = None) -> Any:
+    """sb3-contrib's ``MaskablePPO`` of ``cfg`` on the vectorized goal-selection ``env``: an MLP on the
+    flattened candidate features and globals (``MultiInputPolicy``), the action logits' bias set to the
+    heuristic's ranking (``cfg.heuristic_prior``)."""
+    import torch
+    from sb3_contrib import MaskablePPO
+
+    model = MaskablePPO(
+        "MultiInputPolicy",
+        env,
+        learning_rate=cfg.learning_rate,
+        n_steps=cfg.n_steps,
+        batch_size=cfg.batch_size,
+        n_epochs=cfg.n_epochs,
+        gamma=cfg.gamma,
+        ent_coef=cfg.ent_coef,
+        policy_kwargs={"net_arch": {"pi": [cfg.features_dim, 64], "vf": [cfg.features_dim, 64]}},
+        tensorboard_log=tensorboard_log,
+        seed=cfg.seed,
+        device=cfg.device,
+        verbose=cfg.verbose,
+    )
+    if cfg.heuristic_prior:
+        n = int(env.action_space.n)
+        with torch.no_grad():
+            head = model.policy.action_net
+            head.weight.mul_(0.01)  # start from the prior, not from the random projection
+            head.bias.copy_(torch.tensor([cfg.heuristic_prior * (1.0 - k / n) for k in range(n)]))
+    return model
+
+
 def build_model(cfg: TrainConfig, env: Any, tensorboard_log: str | None = None) -> Any:
-    """The PPO model of ``cfg`` on the vectorized ``env``."""
+    """The model of ``cfg`` on the vectorized ``env``: PPO with the map-state extractor, or
+    :func:`build_maskable` with ``algo = "maskable_ppo"``."""
+    if cfg.algo == "maskable_ppo":
+        return build_maskable(cfg, env, tensorboard_log)
     from stable_baselines3 import PPO
 
     from digslam.agents.learning.extractor import MapStateExtractor
@@ -344,6 +399,8 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = N
             seeds = cfg.eval_seeds()
             held_out = EnvFactory(cfg.env_id, cfg.env_kwargs, cfg.torch_threads, seeds, cfg.actions)
             eval_env = make_vec_env(held_out, 1, seeds[0])
+            if cfg.algo == "maskable_ppo":
+                from sb3_contrib.common.maskable.callbacks import MaskableEvalCallback as EvalCallback
             callbacks.append(
                 EvalCallback(
                     eval_env,
@@ -417,4 +474,5 @@ def _has_progress() -> bool:
 
 
 __all__ = ["DEFAULT_CONFIG", "EnvFactory", "SeedCycle", "TrainConfig", "TrainingInterrupted", "build_model",
-           "make_vec_env", "parse_value", "pin_threads", "train", "write_sidecar"]  # fmt: skip
+           "make_vec_env", "parse_value", "pin_threads", "train", "write_sidecar", "ALGOS", "build_maskable",
+           "env_module"]  # fmt: skip

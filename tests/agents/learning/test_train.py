@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import pickle
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -187,8 +188,9 @@ def test_turn_go_actions_and_tube_penalty() -> None:
     with pytest.raises(ValueError, match="tube_penalty"):
         TrainConfig(tube_penalty=-1.0)
     # the penalty is the growth of the widest side of the pose box, times the weight
-    plain, pen = gym.make("digslam/DigCoverage-v0", map_size=36), TubePenalty(
-        gym.make("digslam/DigCoverage-v0", map_size=36), weight=100.0
+    plain, pen = (
+        gym.make("digslam/DigCoverage-v0", map_size=36),
+        TubePenalty(gym.make("digslam/DigCoverage-v0", map_size=36), weight=100.0),
     )
     plain.reset(seed=4)
     pen.reset(seed=4)
@@ -224,3 +226,30 @@ def test_turn_go_model_acts_in_the_continuous_env(tmp_path) -> None:  # type: ig
     obs, _ = env.reset(seed=2)
     action, _ = policy.predict(obs, deterministic=True)
     assert env.action_space.contains(action) and any(np.array_equal(action, a) for a in TURN_GO)
+
+
+def test_maskable_ppo_trains_on_the_goal_env_from_the_heuristic_prior(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """``algo = "maskable_ppo"`` on the goal-selection env: it trains end to end at tiny size, its logits
+    start from the heuristic's ranking (candidate 0 first), and its model comes with its sidecar."""
+    import torch
+
+    from digslam.agents.learning.train import build_maskable, env_module, make_vec_env, train
+
+    assert env_module("digslam/DigCoverageGoalsRooms-v0") == "digslam.agents.goals"
+    cfg = TrainConfig.from_file(
+        Path(__file__).parents[3] / "agents" / "configs" / "goals_maskable.toml",
+        ["n_envs=1", "total_timesteps=32", "n_steps=16", "batch_size=16", "n_epochs=1", "eval_freq=0",
+         "checkpoint_freq=16", "progress_bar=false", "env_kwargs.max_steps=200", "env_kwargs.step_cap=20",
+         f'out_dir="{tmp_path.as_posix()}"'],
+    )  # fmt: skip
+    vec = make_vec_env(EnvFactory(cfg.env_id, cfg.env_kwargs), 1, 0)
+    model = build_maskable(cfg, vec)
+    bias = model.policy.action_net.bias.detach()
+    assert torch.all(bias[:-1] > bias[1:])  # the heuristic's ranking: candidate 0 first
+    obs = vec.reset()
+    masks = np.stack(vec.env_method("action_masks"))
+    action, _ = model.predict(obs, action_masks=masks, deterministic=True)
+    assert int(action[0]) == 0  # untrained: the heuristic's pick
+    vec.close()
+    path = train(cfg)
+    assert path.is_file() and json.loads(path.with_suffix(".json").read_text())["env_id"] == cfg.env_id

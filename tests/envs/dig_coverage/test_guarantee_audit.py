@@ -20,7 +20,8 @@ from auditor import DARK_CODE, Auditor, GuaranteeBreach, audit_episode, random_a
 import digslam.envs  # noqa: F401  (registers the environments)
 from digslam.envs.dig_coverage.wrapper import GuaranteedObserver
 
-VARIANTS = sorted(i for i in gym.registry if i.startswith("digslam/DigCoverage"))
+#: The certified-coverage ids of ``digslam.envs`` (not the goal-selection ids of ``digslam.agents.goals``).
+VARIANTS = sorted(i for i in gym.registry if i in digslam.envs.COVERAGE_IDS)
 ZERO = {"speed": 0.0, "yaw_rate": 0.0, "heading": 0.0, "range": 0.0}
 
 

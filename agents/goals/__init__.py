@@ -1,0 +1,77 @@
+"""Goal selection: certified coverage as a choice among candidate goals, driven by the frontier agent's loop.
+
+Importing this package registers ``digslam/DigCoverageGoals-v0`` (room) and ``DigCoverageGoalsRocks-v0``,
+``DigCoverageGoalsCaves-v0``, ``DigCoverageGoalsRooms-v0`` (:data:`GOAL_IDS`); in worker processes use
+``"digslam.agents.goals:digslam/DigCoverageGoals-v0"``.
+
+Lives here: :mod:`.driver` (``GoalDriver``: the frontier agent's loop towards a fixed goal, and the events
+that end a macro step), :mod:`.candidates` (the candidate goals and their features, from the observation
+only), :mod:`.env` (``GoalSelectionEnv``, the semi-MDP wrapper), :mod:`.policy` (``FirstCandidatePolicy``,
+``RandomCandidatePolicy``) and :mod:`.registry` (the ids).
+
+May import: :mod:`digslam.envs`, :mod:`digslam.agents.baselines`; numpy, scipy, gymnasium.
+"""
+
+from .candidates import (
+    FEATURES,
+    N_FEATURES,
+    Candidates,
+    candidates,
+    clusters,
+    tiers,
+)
+from .driver import (
+    CLOSURE,
+    FRONTIER,
+    KEEP_FACTOR,
+    KEEP_SLACK,
+    KINDS,
+    TURN,
+    GoalDriver,
+    Plan,
+    driver_for,
+    regret,
+)
+from .env import (
+    GLOBALS,
+    MAX_EMPTY,
+    GoalSelectionEnv,
+)
+from .policy import (
+    FirstCandidatePolicy,
+    RandomCandidatePolicy,
+)
+from .registry import (
+    ENTRY_POINT,
+    GOAL_IDS,
+    register_goal_envs,
+)
+
+register_goal_envs()
+
+__all__ = [
+    "CLOSURE",
+    "Candidates",
+    "ENTRY_POINT",
+    "FEATURES",
+    "FRONTIER",
+    "FirstCandidatePolicy",
+    "GLOBALS",
+    "GOAL_IDS",
+    "GoalDriver",
+    "GoalSelectionEnv",
+    "KEEP_FACTOR",
+    "KEEP_SLACK",
+    "KINDS",
+    "MAX_EMPTY",
+    "N_FEATURES",
+    "Plan",
+    "RandomCandidatePolicy",
+    "TURN",
+    "candidates",
+    "clusters",
+    "driver_for",
+    "register_goal_envs",
+    "regret",
+    "tiers",
+]

@@ -1,0 +1,255 @@
+"""``GoalSelectionEnv``: certified coverage as a choice among candidate goals (a semi-MDP over DigCoverage).
+
+Each decision picks one of ``n_candidates`` goals (:mod:`.candidates`: frontier clusters, an in-place turn,
+loop-closure clusters); :class:`~.driver.GoalDriver` then drives the base env towards it with the frontier
+agent's loop (turn in place, drive straight, re-plan every ``replan_every`` steps towards the *fixed* goal)
+until an event ends the macro step: the goal reached, the goal gone stale or overtaken by a cheaper frontier
+(the frontier agent's hysteresis, see :mod:`.driver`), given up, unreachable, the turn done, the episode
+over, or ``step_cap`` low-level steps.
+
+* action: ``Discrete(n_candidates)``; :meth:`GoalSelectionEnv.action_masks` gives the valid ones
+  (sb3-contrib's ``MaskablePPO`` / ``ActionMasker``); a masked action raises ``ValueError``. A random
+  valid action: ``env.action_space.sample(mask=env.action_masks().astype(np.int8))``;
+* observation: ``{"candidates": Box(-1, 1, (n, F)), "mask": MultiBinary(n), "global": Box(-1, 1, (G,))}``
+  (+ ``"map"``, the base map, with ``include_map``): the features of :data:`.candidates.FEATURES` and
+  :data:`GLOBALS` (the base ``"state"``, the observer's own certified share ``state[9]`` among them, never
+  ``info["certified_coverage"]`` or ``info["true_coverage"]``). A function of the base observations only;
+* reward: ``reward_scale`` x the base rewards summed over the macro step (certified area gained, m², minus
+  the base env's bump penalty) ``- step_cost`` per low-level step ``+ target_bonus`` when a frontier or
+  closure goal is reached;
+* episode: the base env's termination (certified coverage at its ``target``), truncation when the low-level
+  steps reach ``max_steps`` (also the base env's ``TimeLimit`` and ``horizon`` when built here);
+* ``info``: the base env's last info plus ``steps`` (low-level steps of the macro step), ``elapsed``,
+  ``event``, ``kind``, ``goal`` and ``base_reward``.
+
+**Fidelity.** Candidate 0 is the frontier agent's own pick and the driver is its loop, so always taking
+candidate 0 (:class:`~.policy.FirstCandidatePolicy`) makes the same low-level actions as
+:class:`~digslam.agents.baselines.FrontierAgent` on the base env: identical actions and certified-coverage
+curves over 3000 steps on the validation levels 1 000 000-1 000 001 of every generator with the default
+cap, and 1 000 002-1 000 003 with a cap of 13 steps (``tests/agents/goals/test_fidelity.py``). A macro step
+may end before any low-level step (a goal given up at once, a closure target reached at once): the next
+decision is then made on the same observation; after ``MAX_EMPTY`` of those in a row the next one takes its
+first step whatever happens.
+
+**Semi-MDP.** SB3 discounts per decision: ``gamma`` applies once per macro step, whatever its length. No
+discount inside a macro step is applied here; time is charged by ``step_cost`` instead (with
+``gamma`` near 1 the return is about the coverage gained minus ``step_cost`` times the steps taken). The
+default 0.02 m² per step is about a tenth of the frontier agent's mean gain over its first 1000 steps on
+the room (0.15-0.21 m² per step on levels 1 000 000-1 000 002).
+``info["steps"]`` gives the durations for a duration-aware discount (``gamma ** steps``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from digslam.agents.baselines.policy import parse
+from digslam.agents.goals.candidates import N_FEATURES, Candidates, candidates
+from digslam.agents.goals.driver import CLOSURE, FRONTIER, KINDS, TURN, driver_for
+
+#: Global features: the base ``"state"`` (11), then these (all in ``[-1, 1]``).
+GLOBALS = ("state",) * 11 + ("elapsed", "frontier_clusters", "closure_clusters", "dark_share",
+                             "penumbra_share")  # fmt: skip
+#: Consecutive macro steps of no low-level step allowed before the next one takes its step anyway.
+MAX_EMPTY = 2
+
+
+class GoalSelectionEnv(gym.Wrapper):
+    """Goal selection over a certified-coverage env (module docstring).
+
+    Args:
+        env: A ``digslam/DigCoverage*`` env (possibly wrapped); None: ``gym.make(base_id, **base_kwargs)``
+            with ``max_episode_steps=max_steps`` and ``horizon=max_steps`` unless given.
+        base_id: The base env id when ``env`` is None.
+        n_candidates: Candidate slots (the action count).
+        step_cap: Longest macro step (low-level steps).
+        max_steps: Low-level steps per episode (truncation).
+        replan_every: Steps between re-plans while driving (the frontier agent's).
+        step_cost: Reward charged per low-level step (base reward units, m²).
+        target_bonus: Reward when a frontier or closure goal is reached.
+        reward_scale: Factor on the base rewards.
+        include_map: Add the base ``"map"`` to the observation.
+        driver_kwargs: More :class:`~.driver.GoalDriver` arguments (frontier agent settings).
+        render_mode: Passed to the base env when built here.
+        **base_kwargs: DigCoverage keywords (``world``, ``map_size``, ``target``, ...).
+    """
+
+    def __init__(
+        self,
+        env: gym.Env | None = None,
+        *,
+        base_id: str = "digslam/DigCoverage-v0",
+        n_candidates: int = 16,
+        step_cap: int = 100,
+        max_steps: int = 3000,
+        replan_every: int = 10,
+        step_cost: float = 0.02,
+        target_bonus: float = 0.0,
+        reward_scale: float = 1.0,
+        include_map: bool = False,
+        driver_kwargs: Mapping[str, Any] | None = None,
+        render_mode: str | None = None,
+        **base_kwargs: Any,
+    ) -> None:
+        for name, v, lo in (("n_candidates", n_candidates, 2), ("step_cap", step_cap, 1),
+                            ("max_steps", max_steps, 1)):  # fmt: skip
+            if not (isinstance(v, int) and not isinstance(v, bool) and v >= lo):
+                raise ValueError(f"{name}: must be an integer >= {lo}, got {v!r}")
+        for name, v in (("step_cost", step_cost), ("target_bonus", target_bonus),
+                        ("reward_scale", reward_scale)):  # fmt: skip
+            if not np.isfinite(v):
+                raise ValueError(f"{name}: must be finite, got {v!r}")
+        if env is None:
+            kw = {"horizon": max_steps, **base_kwargs}
+            if render_mode is not None:
+                kw["render_mode"] = render_mode
+            env = gym.make(base_id, max_episode_steps=max_steps, **kw)
+        elif base_kwargs or render_mode is not None:
+            raise ValueError(f"base keywords {sorted(base_kwargs)} need env=None (the env is built here)")
+        super().__init__(env)
+        self._goal_spec: Any = None
+        self.n, self.step_cap, self.max_steps = n_candidates, step_cap, max_steps
+        self.step_cost, self.target_bonus = float(step_cost), float(target_bonus)
+        self.reward_scale = float(reward_scale)
+        self.include_map = bool(include_map)
+        self.driver = driver_for(env, replan_every=replan_every, **dict(driver_kwargs or {}))
+        self.action_space = spaces.Discrete(self.n)
+        obs: dict[str, spaces.Space] = {
+            "candidates": spaces.Box(-1.0, 1.0, (self.n, N_FEATURES), np.float32),
+            "mask": spaces.MultiBinary(self.n),
+            "global": spaces.Box(-1.0, 1.0, (len(GLOBALS),), np.float32),
+        }
+        if self.include_map:
+            obs["map"] = env.observation_space["map"]
+        self.observation_space = spaces.Dict(obs)
+        self._base_obs: dict[str, np.ndarray] | None = None
+        self._info: dict[str, Any] = {}
+        self._cands: Candidates | None = None
+        self._t, self._empty = 0, 0
+        self.mem: Any = None  # the driver's memory of the episode (visited pixels, tube widths, goal)
+
+    # --- gymnasium API -------------------------------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[dict, dict]:
+        obs, info = self.env.reset(seed=seed, options=options)
+        self._t, self._empty = 0, 0
+        self.mem = self.driver.begin(np.asarray(obs["map"]).shape[-1])
+        self._info = info
+        return self._decide(obs), dict(info)
+
+    def step(self, action: Any) -> tuple[dict, float, bool, bool, dict]:
+        if self._cands is None or self._base_obs is None:
+            raise RuntimeError("step: call reset first")
+        a = self._check(action)
+        c, mem = self._cands, self.mem
+        kind, goal = int(c.kind[a]), (int(c.goal[a, 0]), int(c.goal[a, 1]))
+        self.driver.start(mem, kind, goal, slack=float(c.slack[a]), keep=bool(c.keep[a]),
+                          watch=kind == TURN and c.n_frontier == 0)  # fmt: skip
+        obs, info = self._base_obs, self._info
+        total, steps, event = 0.0, 0, "cap"
+        terminated = truncated = False
+        while True:
+            view = parse(obs["map"], obs["state"])
+            low, ev = self.driver.act(view, mem) if view.consistent else (np.zeros(2, np.float32), None)
+            if ev is not None and (steps > 0 or self._empty < MAX_EMPTY):
+                event = ev
+                break
+            obs, r, terminated, truncated, info = self.env.step(low)
+            mem.t += 1
+            steps, self._t, total = steps + 1, self._t + 1, total + float(r)
+            if terminated or truncated or self._t >= self.max_steps:
+                truncated = bool(truncated or (self._t >= self.max_steps and not terminated))
+                event = "done"
+                break
+            if steps >= self.step_cap:
+                break
+        self._empty = self._empty + 1 if steps == 0 else 0
+        mem.extra["ended"] = event
+        self._info = info
+        reached = event == "reached" and kind in (FRONTIER, CLOSURE)
+        reward = self.reward_scale * total - self.step_cost * steps + (self.target_bonus if reached else 0.0)
+        info = {**info, "steps": steps, "elapsed": self._t, "event": event, "kind": KINDS[kind], "goal": goal,
+                "base_reward": total}  # fmt: skip
+        return self._decide(obs), float(reward), bool(terminated), bool(truncated), info
+
+    def action_masks(self) -> np.ndarray:
+        """``(n_candidates,)`` bool: the valid actions of the current decision."""
+        if self._cands is None:
+            raise RuntimeError("action_masks: call reset first")
+        return self._cands.mask.copy()
+
+    # --- an environment in its own right -----------------------------------------------------------------
+    @property
+    def unwrapped(self) -> GoalSelectionEnv:  # type: ignore[override]
+        """This env: its spaces, steps and spec are its own (``gym.make`` sets its spec here); the
+        DigCoverage env it drives is :attr:`env`."""
+        return self
+
+    @property
+    def spec(self) -> Any:  # type: ignore[override]
+        return self._goal_spec
+
+    @spec.setter
+    def spec(self, value: Any) -> None:
+        self._goal_spec = value
+
+    @property
+    def _np_random(self) -> Any:  # the base env's generator (gymnasium's checker reads it here)
+        return self.env.unwrapped.np_random
+
+    @_np_random.setter
+    def _np_random(self, value: Any) -> None:
+        if value is not None:
+            self.env.unwrapped.np_random = value
+
+    @property
+    def candidates(self) -> Candidates | None:
+        """The current decision's candidates (goals, kinds, features); None before ``reset``."""
+        return self._cands
+
+    @property
+    def base_observation(self) -> dict[str, np.ndarray] | None:
+        """The base env's observation the current decision was made on; None before ``reset``."""
+        return self._base_obs
+
+    # --- pieces --------------------------------------------------------------------------------------------
+    def _check(self, action: Any) -> int:
+        a = np.asarray(action)
+        whole = np.issubdtype(a.dtype, np.integer) or (
+            np.issubdtype(a.dtype, np.floating) and a.size == 1 and float(a.reshape(-1)[0]).is_integer()
+        )
+        if a.size != 1 or not whole:
+            raise ValueError(f"action: expected one integer candidate index, got {action!r}")
+        i = int(a.reshape(-1)[0])
+        if not 0 <= i < self.n:
+            raise ValueError(f"action: candidate {i} is out of range [0, {self.n})")
+        mask = self._cands.mask  # type: ignore[union-attr]
+        if not mask[i]:
+            raise ValueError(f"action: candidate {i} is masked out (valid: {np.flatnonzero(mask).tolist()})")
+        return i
+
+    def _decide(self, obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """Candidates and observation of the decision on the base observation ``obs``."""
+        self._base_obs = obs
+        view = parse(obs["map"], obs["state"])
+        self._cands = c = candidates(self.driver, view, self.mem, self.n)
+        n = float(self.n)
+        extra = [self._t / self.max_steps, c.n_frontier / n, c.n_closure / n, view.dark.mean(),
+                 view.penumbra.mean()]  # fmt: skip
+        glob = np.concatenate([np.asarray(obs["state"], np.float32)[:11], np.asarray(extra, np.float32)])
+        out = {"candidates": c.features.copy(), "mask": c.mask.astype(np.int8),
+               "global": np.clip(glob, -1.0, 1.0).astype(np.float32)}  # fmt: skip
+        if self.include_map:
+            out["map"] = np.array(obs["map"], copy=True)
+        return out
+
+
+__all__ = [
+    "GLOBALS",
+    "GoalSelectionEnv",
+    "MAX_EMPTY",
+]
