@@ -76,7 +76,7 @@ def cmd_train(args: argparse.Namespace) -> int:
     if config is not None and Path(config).is_dir():
         raise UserError(f"{config}: is a folder; give a .toml or .json training configuration")
     cfg = TrainConfig.from_file(config, overrides)
-    check_env_id(cfg.env_id, "train", opt="env_id")
+    check_env_id(cfg.env_id, "train", opt="env_id", goals=True)
     make_env(cfg.env_id, dict(cfg.env_kwargs), "env_kwargs").close()  # here, before any worker starts
     out_path(cfg.out_dir, "out_dir")
     try:

@@ -43,16 +43,22 @@ def require_ray(what: str) -> None:
         raise UserError(f"{what} needs Ray, which is not installed; {RAY_HINT}") from None
 
 
-def check_env_id(env_id: str, command: str, opt: str = "--env") -> None:
-    """Accept the certified-coverage ids (the agents read the observer's map); otherwise raise
-    :class:`UserError` listing the ids ``digslam COMMAND`` takes."""
+def check_env_id(env_id: str, command: str, opt: str = "--env", goals: bool = False) -> None:
+    """Accept the certified-coverage ids (the agents read the observer's map), and with ``goals`` the
+    goal-selection ids of :mod:`digslam.agents.goals`; otherwise raise :class:`UserError` listing the ids
+    ``digslam COMMAND`` takes."""
     import gymnasium as gym
 
     from digslam import envs
 
-    if env_id in envs.COVERAGE_IDS:
+    known = list(envs.COVERAGE_IDS)
+    if goals:
+        from digslam.agents.goals.registry import GOAL_IDS
+
+        known += list(GOAL_IDS)
+    if env_id in known:
         return
-    ids = ", ".join(envs.COVERAGE_IDS)
+    ids = ", ".join(known)
     if env_id in gym.registry:
         raise UserError(f"{opt} {env_id}: `digslam {command}` takes the certified-coverage environments "
                         f"(the agents read the observer's map): {ids}")  # fmt: skip
