@@ -24,7 +24,6 @@ cluster at ``--address``) with identical results; ``eval_steps_per_s`` is still 
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from pathlib import Path
 from typing import Any
@@ -42,29 +41,29 @@ MODEL = Path(__file__).resolve().parents[1] / "agents" / "data" / "ppo_digcovera
 
 
 def model_kwargs(model: Path) -> dict[str, Any]:
-    """Env keywords of a saved model (its ``.json`` sidecar's ``env_kwargs``, ``fixed_world`` dropped)."""
-    side = model.with_suffix(".json")
-    if not side.is_file():
-        return {}
-    kw = dict(json.loads(side.read_text()).get("env_kwargs", {}))
-    kw.pop("fixed_world", None)
-    kw.pop("max_episode_steps", None)
-    return kw
+    """Env keywords of a saved model (:func:`digslam.agents.learning.models.model_env_kwargs`: its sidecar's,
+    or its training run's, less the training-only ones; the low-level keywords of a goal-selection model)."""
+    from digslam.agents.learning.models import model_env_kwargs
+
+    return model_env_kwargs(model)
 
 
 def load_ppo(model: Path) -> Any:
-    """The PPO policy at ``model`` (torch on one thread), or None with a printed note."""
+    """The saved model at ``model`` as a policy of the low-level env (torch on one thread; a goal-selection
+    MaskablePPO model comes as a ``GoalAgent``), or None with a printed note."""
     if not model.is_file():
         print(f"note: no PPO model at {model}; PPO skipped")
         return None
     try:
-        import torch
-        from stable_baselines3 import PPO
+        from digslam.agents.learning.models import load_ppo as load
     except ImportError as exc:
         print(f"note: stable-baselines3 unavailable ({exc}); PPO skipped")
         return None
-    torch.set_num_threads(1)
-    return PPO.load(str(model), device="cpu")
+    env = gym.make(ENV_ID, **model_kwargs(model))
+    try:
+        return load(model, env)
+    finally:
+        env.close()
 
 
 def main() -> None:

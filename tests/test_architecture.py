@@ -34,7 +34,7 @@ ALLOWED: dict[str, set[str]] = {
     "envs.dig_coverage": {"observer.core", "observer.slam", "observer.thick", "observer.online", "envs.sim",
                           "envs.explore", "envs"},
     "agents.baselines": {"observer.core", "envs"},
-    "agents.learning": {"observer.core", "envs", "agents.baselines", "agents.evaluation"},
+    "agents.learning": {"observer.core", "envs", "agents.baselines", "agents.evaluation", "agents.goals"},
     "agents.evaluation": {"observer.core", "observer.thick", "envs", "envs.sim", "envs.explore",
                           "envs.dig_coverage", "agents.baselines", "agents.learning"},
     "agents.goals": {"envs", "agents.baselines"},

@@ -3,6 +3,11 @@
 The model registry (the shipped policy, its environment keywords, loading a ``.zip``) is
 :mod:`digslam.agents.learning.models`; here its :class:`~digslam.agents.learning.models.ModelError` becomes a
 :class:`~digslam.agents.cli.common.UserError` worded with the command's options.
+
+``--agent ppo --model M`` also takes a goal-level model (a ``MaskablePPO`` trained on
+``digslam/DigCoverageGoals*``, as its sidecar says): it acts in the ``--env`` low-level env as a
+:class:`~digslam.agents.goals.GoalAgent`, built with the low-level keywords :func:`model_env_kwargs` reads
+from that sidecar.
 """
 
 from __future__ import annotations
@@ -40,8 +45,9 @@ def load_ppo(path: Path, env: Any) -> Any:
 
 
 def load_agent(name: str, env: Any, model: Path | None = None) -> Any:
-    """A policy with SB3's ``predict``: ``"ppo"`` (a saved PPO model, default the shipped one) or a
-    baseline name of :data:`digslam.agents.baselines.registry.BASELINES`.
+    """A policy with SB3's ``predict``: ``"ppo"`` (a saved PPO model, default the shipped one; a goal-level
+    model comes as a :class:`~digslam.agents.goals.GoalAgent`) or a baseline name of
+    :data:`digslam.agents.baselines.registry.BASELINES`.
 
     Raises:
         UserError: unknown ``name``, or a model that cannot be loaded for ``env``.

@@ -102,8 +102,8 @@ def build_policy(
     spec: PolicySpec, env_id: str, env_kwargs: Mapping[str, Any] | None = None, seed: int | None = None
 ) -> Any:
     """The policy of ``spec``: ``make_baseline(spec, env, seed=seed)`` for a baseline name, else
-    ``PPO.load(spec)`` as a policy of the continuous environment (:func:`.models.as_policy`; ``seed``
-    unused).
+    the saved model at ``spec`` as a policy of the low-level environment (:func:`.models.load_ppo`: a
+    turn-or-go model mapped to ``(v, ω)``, a goal-selection model as a ``GoalAgent``; ``seed`` unused).
 
     The environment (made only for its spaces) is closed before returning.
     """
@@ -120,9 +120,11 @@ def build_policy(
             env.close()
     if not Path(spec).is_file():
         raise ValueError(f"spec: no baseline named {spec!r} and no model file at that path")
-    from stable_baselines3 import PPO
-
-    return models.as_policy(PPO.load(spec, device="cpu"))
+    env = gym.make(env_id, **dict(env_kwargs or {}))
+    try:
+        return models.load_ppo(spec, env)
+    finally:
+        env.close()
 
 
 def evaluate_one(

@@ -6,12 +6,21 @@ Importing this package registers ``digslam/DigCoverageGoals-v0`` (room) and ``Di
 
 Lives here: :mod:`.driver` (``GoalDriver``: the frontier agent's loop towards a fixed goal, and the events
 that end a macro step), :mod:`.candidates` (the candidate goals and their features, from the observation
-only), :mod:`.env` (``GoalSelectionEnv``, the semi-MDP wrapper), :mod:`.policy` (``FirstCandidatePolicy``,
-``RandomCandidatePolicy``) and :mod:`.registry` (the ids).
+only), :mod:`.env` (``GoalSelectionEnv``, the semi-MDP wrapper), :mod:`.agent` (``GoalAgent``: a goal-level
+chooser, e.g. a trained ``MaskablePPO``, as a policy of the low-level env, step by step), :mod:`.policy`
+(``FirstCandidatePolicy``, ``RandomCandidatePolicy``) and :mod:`.registry` (the ids).
 
 May import: :mod:`digslam.envs`, :mod:`digslam.agents.baselines`; numpy, scipy, gymnasium.
 """
 
+from .agent import (
+    GOAL_KWARGS,
+    REWARD_KWARGS,
+    GoalAgent,
+    MacroState,
+    base_env_kwargs,
+    split_goal_kwargs,
+)
 from .candidates import (
     FEATURES,
     N_FEATURES,
@@ -58,20 +67,26 @@ __all__ = [
     "FirstCandidatePolicy",
     "GLOBALS",
     "GOAL_IDS",
+    "GOAL_KWARGS",
+    "GoalAgent",
     "GoalDriver",
     "GoalSelectionEnv",
     "KEEP_FACTOR",
     "KEEP_SLACK",
     "KINDS",
     "MAX_EMPTY",
+    "MacroState",
     "N_FEATURES",
     "Plan",
+    "REWARD_KWARGS",
     "RandomCandidatePolicy",
     "TURN",
+    "base_env_kwargs",
     "candidates",
     "clusters",
     "driver_for",
     "register_goal_envs",
     "regret",
+    "split_goal_kwargs",
     "tiers",
 ]

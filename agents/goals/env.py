@@ -48,9 +48,9 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from digslam.agents.baselines.policy import parse
+from digslam.agents.baselines.policy import Memory, parse
 from digslam.agents.goals.candidates import N_FEATURES, Candidates, candidates
-from digslam.agents.goals.driver import CLOSURE, FRONTIER, KINDS, TURN, driver_for
+from digslam.agents.goals.driver import CLOSURE, FRONTIER, KINDS, TURN, GoalDriver, driver_for
 
 #: Global features: the base ``"state"`` (11), then these (all in ``[-1, 1]``).
 GLOBALS = ("state",) * 11 + ("elapsed", "frontier_clusters", "closure_clusters", "dark_share",
@@ -119,14 +119,7 @@ class GoalSelectionEnv(gym.Wrapper):
         self.include_map = bool(include_map)
         self.driver = driver_for(env, replan_every=replan_every, **dict(driver_kwargs or {}))
         self.action_space = spaces.Discrete(self.n)
-        obs: dict[str, spaces.Space] = {
-            "candidates": spaces.Box(-1.0, 1.0, (self.n, N_FEATURES), np.float32),
-            "mask": spaces.MultiBinary(self.n),
-            "global": spaces.Box(-1.0, 1.0, (len(GLOBALS),), np.float32),
-        }
-        if self.include_map:
-            obs["map"] = env.observation_space["map"]
-        self.observation_space = spaces.Dict(obs)
+        self.observation_space = goal_space(self.n, env.observation_space["map"] if include_map else None)
         self._base_obs: dict[str, np.ndarray] | None = None
         self._info: dict[str, Any] = {}
         self._cands: Candidates | None = None
@@ -145,17 +138,14 @@ class GoalSelectionEnv(gym.Wrapper):
         if self._cands is None or self._base_obs is None:
             raise RuntimeError("step: call reset first")
         a = self._check(action)
-        c, mem = self._cands, self.mem
-        kind, goal = int(c.kind[a]), (int(c.goal[a, 0]), int(c.goal[a, 1]))
-        self.driver.start(mem, kind, goal, slack=float(c.slack[a]), keep=bool(c.keep[a]),
-                          watch=kind == TURN and c.n_frontier == 0)  # fmt: skip
+        mem = self.mem
+        kind, goal = start_goal(self.driver, mem, self._cands, a)
         obs, info = self._base_obs, self._info
         total, steps, event = 0.0, 0, "cap"
         terminated = truncated = False
         while True:
-            view = parse(obs["map"], obs["state"])
-            low, ev = self.driver.act(view, mem) if view.consistent else (np.zeros(2, np.float32), None)
-            if ev is not None and (steps > 0 or self._empty < MAX_EMPTY):
+            low, ev = drive(self.driver, obs, mem)
+            if ends(ev, steps, self._empty):
                 event = ev
                 break
             obs, r, terminated, truncated, info = self.env.step(low)
@@ -235,21 +225,68 @@ class GoalSelectionEnv(gym.Wrapper):
     def _decide(self, obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         """Candidates and observation of the decision on the base observation ``obs``."""
         self._base_obs = obs
-        view = parse(obs["map"], obs["state"])
-        self._cands = c = candidates(self.driver, view, self.mem, self.n)
-        n = float(self.n)
-        extra = [self._t / self.max_steps, c.n_frontier / n, c.n_closure / n, view.dark.mean(),
-                 view.penumbra.mean()]  # fmt: skip
-        glob = np.concatenate([np.asarray(obs["state"], np.float32)[:11], np.asarray(extra, np.float32)])
-        out = {"candidates": c.features.copy(), "mask": c.mask.astype(np.int8),
-               "global": np.clip(glob, -1.0, 1.0).astype(np.float32)}  # fmt: skip
-        if self.include_map:
-            out["map"] = np.array(obs["map"], copy=True)
+        self._cands, out = decide(self.driver, obs, self.mem, self.n, self._t, self.max_steps,
+                                  self.include_map)  # fmt: skip
         return out
+
+
+# --- shared with :class:`~.agent.GoalAgent` (the same macro steps, one low-level step at a time) ---------
+def goal_space(n: int, map_space: spaces.Space | None = None) -> spaces.Dict:
+    """The observation space of ``n`` candidate slots (with the base ``map_space``: ``include_map``)."""
+    obs: dict[str, spaces.Space] = {
+        "candidates": spaces.Box(-1.0, 1.0, (n, N_FEATURES), np.float32),
+        "mask": spaces.MultiBinary(n),
+        "global": spaces.Box(-1.0, 1.0, (len(GLOBALS),), np.float32),
+    }
+    if map_space is not None:
+        obs["map"] = map_space
+    return spaces.Dict(obs)
+
+
+def decide(driver: GoalDriver, obs: Mapping[str, np.ndarray], mem: Memory, n: int, t: int, max_steps: int,
+           include_map: bool = False) -> tuple[Candidates, dict[str, np.ndarray]]:  # fmt: skip
+    """The candidates and the observation of a decision on the base observation ``obs``, ``t`` low-level
+    steps into an episode of ``max_steps`` (runs the driver's bookkeeping on it)."""
+    view = parse(obs["map"], obs["state"])
+    c = candidates(driver, view, mem, n)
+    nf = float(n)
+    extra = [t / max_steps, c.n_frontier / nf, c.n_closure / nf, view.dark.mean(), view.penumbra.mean()]
+    glob = np.concatenate([np.asarray(obs["state"], np.float32)[:11], np.asarray(extra, np.float32)])
+    out = {"candidates": c.features.copy(), "mask": c.mask.astype(np.int8),
+           "global": np.clip(glob, -1.0, 1.0).astype(np.float32)}  # fmt: skip
+    if include_map:
+        out["map"] = np.array(obs["map"], copy=True)
+    return c, out
+
+
+def start_goal(driver: GoalDriver, mem: Memory, c: Candidates, a: int) -> tuple[int, tuple[int, int]]:
+    """Start the macro step towards candidate ``a`` of ``c``; returns its kind and goal pixel."""
+    kind, goal = int(c.kind[a]), (int(c.goal[a, 0]), int(c.goal[a, 1]))
+    driver.start(mem, kind, goal, slack=float(c.slack[a]), keep=bool(c.keep[a]),
+                 watch=kind == TURN and c.n_frontier == 0)  # fmt: skip
+    return kind, goal
+
+
+def drive(driver: GoalDriver, obs: Mapping[str, np.ndarray], mem: Memory) -> tuple[np.ndarray, str | None]:
+    """The driver's low-level action on the base observation ``obs`` and the event that ends the macro step
+    (None: go on); zero and no event when the observer found the data inconsistent."""
+    view = parse(obs["map"], obs["state"])
+    return driver.act(view, mem) if view.consistent else (np.zeros(2, np.float32), None)
+
+
+def ends(event: str | None, steps: int, empty: int) -> bool:
+    """Whether ``event`` ends a macro step that took ``steps`` low-level steps, after ``empty`` macro steps in
+    a row that took none (after :data:`MAX_EMPTY` of those the next one takes its first step anyway)."""
+    return event is not None and (steps > 0 or empty < MAX_EMPTY)
 
 
 __all__ = [
     "GLOBALS",
     "GoalSelectionEnv",
     "MAX_EMPTY",
+    "decide",
+    "drive",
+    "ends",
+    "goal_space",
+    "start_goal",
 ]

@@ -6,12 +6,21 @@ model saved by ``digslam train`` has one). :func:`load_ppo` reads a saved PPO ``
 an environment's observation space. A model or sidecar that cannot be used raises :class:`ModelError` (a
 ``ValueError``) in one line that names the file and says what to do; the command line shows it as is.
 
-Torch and stable-baselines3 are imported only by :func:`load_ppo`.
+**Goal-level models.** A model whose sidecar names a goal-selection env (``digslam/DigCoverageGoals*``,
+:mod:`digslam.agents.goals`; sb3-contrib's ``MaskablePPO``, ``algo = "maskable_ppo"``) picks candidate goals,
+not low-level actions: :func:`load_ppo` returns it inside a
+:class:`~digslam.agents.goals.GoalAgent`, a policy of the low-level env like any other, and
+:func:`model_env_kwargs` gives the keywords of the *low-level* env (the goal env's own keywords, such as
+``n_candidates`` or ``step_cap``, go to the ``GoalAgent`` instead; the ``horizon`` is the goal env's
+``max_steps``). :mod:`digslam.agents.goals` is imported by its name (:func:`~.train.env_module`, as
+``gym.make`` imports it for these ids), on use only.
+
+Torch, stable-baselines3 and sb3-contrib are imported only by :func:`load_ppo`.
 
 >>> DEFAULT_ENV, PRETRAINED.name
 ('digslam/DigCoverage-v0', 'ppo_digcoverage.zip')
 >>> sorted(model_env_kwargs())  # the sidecar's keywords, less the training-only ones (``fixed_world``)
-['crop', 'map_size']
+['crop', 'dynamics', 'map_size']
 """
 
 from __future__ import annotations
@@ -28,6 +37,8 @@ PRETRAINED = DATA / "ppo_digcoverage.zip"
 DEFAULT_ENV = "digslam/DigCoverage-v0"
 
 
+#: The package of the goal-selection envs (:func:`~.train.env_module` of their ids).
+GOALS = "digslam.agents.goals"
 #: Environment keywords of a training run that are no part of what the model sees.
 TRAINING_ONLY = ("fixed_world", "max_episode_steps", "render_mode")
 
@@ -42,11 +53,10 @@ def _first_line(exc: BaseException) -> str:
     return text[0] if text else type(exc).__name__
 
 
-def model_env_kwargs(model: str | Path | None = None) -> dict[str, Any]:
-    """Environment keywords of a saved model (None: :data:`PRETRAINED`), read from its ``.json`` sidecar,
-    else from the ``config.json`` of the ``digslam train`` run that holds it (its folder, or one up for a
-    checkpoint), else ``{}``; the training choices of :data:`TRAINING_ONLY`, no part of the observation,
-    are left out (each command sets its own episode length).
+def model_meta(model: str | Path | None = None) -> dict[str, Any]:
+    """The whole sidecar of a saved model (None: :data:`PRETRAINED`): its ``<model>.json`` (``env_id``,
+    ``env_kwargs``, ``actions``), else the ``config.json`` of the ``digslam train`` run that holds it (its
+    folder, or one up for a checkpoint), else ``{}``; ``env_kwargs`` is always a dict when present.
 
     Raises:
         ModelError: the sidecar is not one written by ``digslam train``.
@@ -59,10 +69,43 @@ def model_env_kwargs(model: str | Path | None = None) -> dict[str, Any]:
         if not side.is_file():
             return {}
     try:
-        kw = dict(json.loads(side.read_text()).get("env_kwargs", {}))
+        meta = json.loads(side.read_text())
+        meta = {**meta, "env_kwargs": dict(meta.get("env_kwargs", {}))}
     except (OSError, ValueError, AttributeError, TypeError) as exc:
         raise ModelError(f"{side}: not a model sidecar written by `digslam train` ({_first_line(exc)}); "
                          "fix or delete it") from None  # fmt: skip
+    return meta
+
+
+def goal_env_id(meta: dict[str, Any]) -> str | None:
+    """The goal-selection env id a sidecar (:func:`model_meta`) names, or None (a low-level model)."""
+    from digslam.agents.learning.train import env_module
+
+    env_id = meta.get("env_id")
+    return env_id if isinstance(env_id, str) and env_module(env_id) == GOALS else None
+
+
+def _goals() -> Any:
+    """:mod:`digslam.agents.goals` (registers the goal ids), imported on use."""
+    import digslam.agents.goals as goals
+
+    return goals
+
+
+def model_env_kwargs(model: str | Path | None = None) -> dict[str, Any]:
+    """Environment keywords of a saved model (None: :data:`PRETRAINED`), read from its sidecar
+    (:func:`model_meta`), else ``{}``; the training choices of :data:`TRAINING_ONLY`, no part of the
+    observation, are left out (each command sets its own episode length). For a goal-level model, those of
+    the low-level env it acts in: the goal env's own keywords are left out and its ``max_steps`` becomes the
+    ``horizon`` (:func:`digslam.agents.goals.base_env_kwargs`).
+
+    Raises:
+        ModelError: the sidecar is not one written by ``digslam train``.
+    """
+    meta = model_meta(model)
+    kw = dict(meta.get("env_kwargs", {}))
+    if goal_env_id(meta) is not None:
+        kw = _goals().base_env_kwargs(kw)
     for key in TRAINING_ONLY:
         kw.pop(key, None)
     return kw
@@ -81,35 +124,46 @@ def as_policy(model: Any) -> Any:
 def load_ppo(path: str | Path, env: Any, opt: str = "model") -> Any:
     """The saved PPO model at ``path`` (on the CPU, torch on one thread), checked against ``env``'s
     observation space; a model trained on discrete turn-or-go actions (``actions = "turn_go"``) comes
-    wrapped in :class:`~.wrappers.TurnGoPolicy`, so that it acts in the continuous environment.
+    wrapped in :class:`~.wrappers.TurnGoPolicy`, so that it acts in the continuous environment; a goal-level
+    model (its sidecar names a ``digslam/DigCoverageGoals*`` env) is loaded as sb3-contrib's ``MaskablePPO``
+    and comes inside a :class:`~digslam.agents.goals.GoalAgent` sized from ``env`` with the goal keywords of
+    its sidecar, its observation space checked against the goal observations that agent makes.
 
     Args:
         path: A ``.zip`` saved by ``digslam train`` (or SB3's ``PPO.save``).
-        env: The environment the model will act in.
+        env: The (low-level) environment the model will act in.
         opt: How the messages name the model (the command line passes ``"--model"``).
 
     Raises:
-        ModelError: no such file, stable-baselines3 missing, not a PPO model, or trained on other
-            observations than ``env`` gives.
+        ModelError: no such file, stable-baselines3 (or sb3-contrib) missing, not a PPO model, or trained on
+            other observations than ``env`` gives.
     """
     path = Path(path)
     if not path.is_file():
         what = "is a folder" if path.is_dir() else "does not exist"
         raise ModelError(f"{opt} {path}: {what}; give a .zip saved by `digslam train` "
                          f"(or leave {opt} out for the shipped policy)")  # fmt: skip
+    meta = model_meta(path)
+    goal_id = goal_env_id(meta)
     try:
-        from stable_baselines3 import PPO
+        if goal_id is not None:
+            from sb3_contrib import MaskablePPO as PPO
+        else:
+            from stable_baselines3 import PPO
     except ImportError:
-        raise ModelError(f"{opt} needs stable-baselines3 and torch; install the train extra: "
-                         'pip install "digslam[train]"') from None  # fmt: skip
+        raise ModelError(f"{opt} needs stable-baselines3{', sb3-contrib' if goal_id else ''} and torch; "
+                         'install the train extra: pip install "digslam[train]"') from None  # fmt: skip
     from digslam.agents.learning.train import pin_threads
 
     pin_threads(1)
+    kind = f"MaskablePPO model of {goal_id}" if goal_id else "PPO model"
     try:
         model = PPO.load(path, device="cpu")
     except Exception as exc:  # noqa: BLE001 - any failure to read the file is the file's
-        raise ModelError(f"{opt} {path}: not a PPO model saved by `digslam train` "
+        raise ModelError(f"{opt} {path}: not a {kind} saved by `digslam train` "
                          f"({type(exc).__name__}: {_first_line(exc)})") from None  # fmt: skip
+    if goal_id is not None:
+        return _goal_agent(model, path, env, meta, opt)
     try:
         model = as_policy(model)
     except ValueError as exc:
@@ -121,5 +175,22 @@ def load_ppo(path: str | Path, env: Any, opt: str = "model") -> Any:
     return model
 
 
-__all__ = ["DATA", "DEFAULT_ENV", "PRETRAINED", "TRAINING_ONLY", "ModelError", "as_policy", "load_ppo",
-           "model_env_kwargs"]  # fmt: skip
+def _goal_agent(model: Any, path: Path, env: Any, meta: dict[str, Any], opt: str) -> Any:
+    """``model`` (a goal-level ``MaskablePPO``) inside a ``GoalAgent`` on ``env``, checked."""
+    goals = _goals()
+    goal_kw, _ = goals.split_goal_kwargs(meta.get("env_kwargs", {}))
+    goal_kw.pop("max_steps", None)  # the episode's length is the env's (its horizon, which the sidecar set)
+    try:
+        agent = goals.GoalAgent.from_env(env, model, **goal_kw)
+        want = agent.goal_observation_space
+    except (ValueError, TypeError, KeyError) as exc:
+        raise ModelError(f"{opt} {path}: cannot act in this environment ({_first_line(exc)})") from None
+    if model.observation_space != want:
+        raise ModelError(f"{opt} {path}: trained on goal observations {model.observation_space}, but the "
+                         f"environment gives {want}; pass the environment keywords it was trained with "
+                         f"in {path.with_suffix('.json')}")  # fmt: skip
+    return agent
+
+
+__all__ = ["DATA", "DEFAULT_ENV", "GOALS", "PRETRAINED", "TRAINING_ONLY", "ModelError", "as_policy",
+           "goal_env_id", "load_ppo", "model_env_kwargs", "model_meta"]  # fmt: skip
