@@ -8,9 +8,12 @@ split (``digslam.envs.splits``), ``target=1.0`` (no early end), ``--steps`` step
 (:func:`digslam.agents.evaluation.suite.run_suite`). Prints the leaderboard (T90 per generator with its
 success rate, T90 / AUC / final tube over all maps, and the ratio to the best baseline with its paired
 bootstrap 95 % interval), writes ``leaderboard.md``, ``leaderboard.png`` and ``suite.json`` to ``--out``,
-and ends with ``heuristic_t90_success=<share of the test maps, over all generators, on which the best
+then prints ``heuristic_t90_success=<share of the test maps, over all generators, on which the best
 baseline reaches 0.9 certified coverage>`` and ``eval_steps_per_s=<observed env steps per second with the
-frontier agent, one process>``.
+frontier agent, one process>``; with a learned model it ends with ``speedup_t95=`` and
+``speedup_t90=<geometric mean over the test maps of all generators of T90(best baseline) / T90(learned)>``
+[paired bootstrap 95 % interval], each after its per-generator values. ``--model`` takes any model of
+``digslam train``, a goal-selection MaskablePPO model included.
 
 Usage: ``python benchmarks/bench_agents.py [--quick] [--maps 30] [--steps 3000] [--out DIR] [--model PATH]
 [--ray [--address A] [--workers N]]`` (also ``digslam benchmark agents ...``). The full suite (4 generators x
@@ -32,7 +35,7 @@ import gymnasium as gym
 
 import digslam.envs  # noqa: F401  (registers the environments)
 from digslam.agents.baselines.registry import BASELINES, make_baseline
-from digslam.agents.evaluation.metrics import paired_bootstrap_ratio
+from digslam.agents.evaluation.metrics import paired_bootstrap_geomean
 from digslam.agents.evaluation.ray_eval import run_suite_ray
 from digslam.agents.evaluation.suite import run_suite, steps_per_second
 
@@ -108,14 +111,20 @@ def main() -> None:
     print(f"wrote {args.out / 'leaderboard.md'}, {res.figure(args.out / 'leaderboard.png')} and "
           f"{res.to_json(args.out / 'suite.json')}")  # fmt: skip
     best = res.best(list(BASELINES))
-    if ppo is not None:
-        t = res.t90()
-        r, lo, hi = paired_bootstrap_ratio(t[best], t["ppo"])
-        print(f"ppo_speedup_t90={r:.4f} [{lo:.4f}, {hi:.4f}] (T90 of {best} / T90 of ppo)")
     rate = steps_per_second(policies["frontier"], ENV_ID, steps=min(2000, 10 * steps))
     print(f"best_baseline={best}")
     print(f"heuristic_t90_success={res.success(best):.4f}")
     print(f"eval_steps_per_s={rate:.0f}")
+    if ppo is not None:  # the learned agent (--model): geometric mean over the maps of T(best) / T(learned)
+        for level in ("T95", "T90"):
+            t = res.t90(level)
+            m = res.metrics()
+            for g in res.results:
+                r, lo, hi = paired_bootstrap_geomean(m[g][best][level], m[g]["ppo"][level])
+                print(f"speedup_{level.lower()}_{g}={r:.4f} [{lo:.4f}, {hi:.4f}]")
+            r, lo, hi = paired_bootstrap_geomean(t[best], t["ppo"])
+            print(f"speedup_{level.lower()}={r:.4f} [{lo:.4f}, {hi:.4f}] ({level} of {best} / {level} of ppo, "
+                  "geometric mean over the maps)")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -13,6 +13,7 @@ from digslam.agents.evaluation.metrics import (
     auc,
     episode_metrics,
     metrics_table,
+    paired_bootstrap_geomean,
     paired_bootstrap_ratio,
     path_length,
     summarize,
@@ -92,3 +93,16 @@ def test_the_evaluator_measures_the_true_path_and_gives_the_metrics() -> None:
     assert 0.5 < travelled <= 40 * 1.0 * 0.1 + 1e-6  # moved, at most max_speed * dt per step
     m = res.metrics()["frontier"]
     assert m["path_length"][0] == travelled and m["T95"][0] == 40.0 and m["S95"][0] == 0.0
+
+
+def test_paired_bootstrap_geomean_is_the_geometric_mean_of_the_per_map_ratios() -> None:
+    rng = np.random.default_rng(3)
+    b = rng.uniform(500, 3000, 40)
+    a = b * np.exp(rng.normal(np.log(1.2), 0.1, 40))  # about 1.2x slower than b on every map
+    r, lo, hi = paired_bootstrap_geomean(a, b, seed=1)
+    assert r == pytest.approx(float(np.exp(np.mean(np.log(a / b)))))
+    assert lo < r < hi and 1.1 < lo and hi < 1.3
+    assert paired_bootstrap_geomean(a, b, seed=1) == (r, lo, hi)
+    assert paired_bootstrap_geomean(np.array([2.0, np.nan, 0.0]), np.array([1.0, 1.0, 1.0]))[0] == 2.0
+    with pytest.raises(ValueError, match="pair"):
+        paired_bootstrap_geomean(np.array([1.0]), np.array([1.0, 2.0]))
