@@ -108,6 +108,18 @@ def summarize(values: Mapping[str, np.ndarray]) -> dict[str, dict[str, float]]:
     return out
 
 
+def _pairs(a: np.ndarray, b: np.ndarray, n_boot: int, confidence: float) -> tuple[np.ndarray, np.ndarray]:
+    """``a``, ``b`` as flat float arrays, checked to pair up, with the bootstrap's settings checked."""
+    x, y = np.asarray(a, dtype=np.float64).ravel(), np.asarray(b, dtype=np.float64).ravel()
+    if x.shape != y.shape:
+        raise ValueError(f"a, b: must pair up (same length), got {x.size} and {y.size}")
+    if not (isinstance(n_boot, int) and n_boot >= 1 and 0.0 < confidence < 1.0):
+        raise ValueError(
+            f"n_boot, confidence: need n_boot >= 1 and 0 < confidence < 1, got {n_boot}, {confidence}"
+        )
+    return x, y
+
+
 def paired_bootstrap_ratio(a: np.ndarray, b: np.ndarray, n_boot: int = 10_000, seed: int = 0,
                            confidence: float = 0.95) -> tuple[float, float, float]:  # fmt: skip
     """``(mean(a) / mean(b), low, high)``: the ratio of two agents' means over the same maps (``a[i]`` and
@@ -119,13 +131,7 @@ def paired_bootstrap_ratio(a: np.ndarray, b: np.ndarray, n_boot: int = 10_000, s
         ValueError: ``a`` and ``b`` differ in length, no finite pair is left, or a bad ``n_boot`` /
             ``confidence``.
     """
-    x, y = np.asarray(a, dtype=np.float64).ravel(), np.asarray(b, dtype=np.float64).ravel()
-    if x.shape != y.shape:
-        raise ValueError(f"a, b: must pair up (same length), got {x.size} and {y.size}")
-    if not (isinstance(n_boot, int) and n_boot >= 1 and 0.0 < confidence < 1.0):
-        raise ValueError(
-            f"n_boot, confidence: need n_boot >= 1 and 0 < confidence < 1, got {n_boot}, {confidence}"
-        )
+    x, y = _pairs(a, b, n_boot, confidence)
     keep = np.isfinite(x) & np.isfinite(y)
     x, y = x[keep], y[keep]
     if x.size == 0:
@@ -152,13 +158,7 @@ def paired_bootstrap_geomean(a: np.ndarray, b: np.ndarray, n_boot: int = 10_000,
     Raises:
         ValueError: as :func:`paired_bootstrap_ratio`.
     """
-    x, y = np.asarray(a, dtype=np.float64).ravel(), np.asarray(b, dtype=np.float64).ravel()
-    if x.shape != y.shape:
-        raise ValueError(f"a, b: must pair up (same length), got {x.size} and {y.size}")
-    if not (isinstance(n_boot, int) and n_boot >= 1 and 0.0 < confidence < 1.0):
-        raise ValueError(
-            f"n_boot, confidence: need n_boot >= 1 and 0 < confidence < 1, got {n_boot}, {confidence}"
-        )
+    x, y = _pairs(a, b, n_boot, confidence)
     keep = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
     logs = np.log(x[keep]) - np.log(y[keep])
     if logs.size == 0:

@@ -275,6 +275,14 @@ def env_module(env_id: str) -> str:
     return "digslam.agents.goals" if env_id.split("/")[-1].startswith("DigCoverageGoals") else "digslam.envs"
 
 
+def _ppo_kwargs(cfg: TrainConfig, tensorboard_log: str | None) -> dict[str, Any]:
+    """The PPO hyperparameters of ``cfg`` that PPO and MaskablePPO share."""
+    return {"learning_rate": cfg.learning_rate, "n_steps": cfg.n_steps, "batch_size": cfg.batch_size,
+            "n_epochs": cfg.n_epochs, "gamma": cfg.gamma, "ent_coef": cfg.ent_coef,
+            "tensorboard_log": tensorboard_log, "seed": cfg.seed, "device": cfg.device,
+            "verbose": cfg.verbose}  # fmt: skip
+
+
 def build_maskable(cfg: TrainConfig, env: Any, tensorboard_log: str | None = None) -> Any:
     """sb3-contrib's ``MaskablePPO`` of ``cfg`` on the vectorized goal-selection ``env``: an MLP on the
     flattened candidate features and globals (``MultiInputPolicy``), the action logits' bias set to the
@@ -282,20 +290,9 @@ def build_maskable(cfg: TrainConfig, env: Any, tensorboard_log: str | None = Non
     import torch
     from sb3_contrib import MaskablePPO
 
+    arch = {"pi": [cfg.features_dim, 64], "vf": [cfg.features_dim, 64]}
     model = MaskablePPO(
-        "MultiInputPolicy",
-        env,
-        learning_rate=cfg.learning_rate,
-        n_steps=cfg.n_steps,
-        batch_size=cfg.batch_size,
-        n_epochs=cfg.n_epochs,
-        gamma=cfg.gamma,
-        ent_coef=cfg.ent_coef,
-        policy_kwargs={"net_arch": {"pi": [cfg.features_dim, 64], "vf": [cfg.features_dim, 64]}},
-        tensorboard_log=tensorboard_log,
-        seed=cfg.seed,
-        device=cfg.device,
-        verbose=cfg.verbose,
+        "MultiInputPolicy", env, policy_kwargs={"net_arch": arch}, **_ppo_kwargs(cfg, tensorboard_log)
     )
     if cfg.heuristic_prior:
         n = int(env.action_space.n)
@@ -320,21 +317,7 @@ def build_model(cfg: TrainConfig, env: Any, tensorboard_log: str | None = None) 
         "features_extractor_kwargs": {"features_dim": cfg.features_dim},
         "net_arch": {"pi": [64], "vf": [64]},
     }
-    return PPO(
-        "MultiInputPolicy",
-        env,
-        learning_rate=cfg.learning_rate,
-        n_steps=cfg.n_steps,
-        batch_size=cfg.batch_size,
-        n_epochs=cfg.n_epochs,
-        gamma=cfg.gamma,
-        ent_coef=cfg.ent_coef,
-        policy_kwargs=policy_kwargs,
-        tensorboard_log=tensorboard_log,
-        seed=cfg.seed,
-        device=cfg.device,
-        verbose=cfg.verbose,
-    )
+    return PPO("MultiInputPolicy", env, policy_kwargs=policy_kwargs, **_ppo_kwargs(cfg, tensorboard_log))
 
 
 class TrainingInterrupted(KeyboardInterrupt):
