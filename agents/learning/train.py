@@ -80,6 +80,9 @@ class TrainConfig(Config):
             (:class:`~.wrappers.TubePenalty`; 0: none).
         algo: ``"ppo"`` (stable-baselines3) or ``"maskable_ppo"`` (sb3-contrib's ``MaskablePPO``, for the
             goal-selection envs of :mod:`digslam.agents.goals`, whose invalid candidates are masked).
+        resume: Continue the run in ``out_dir`` from its latest saved model (:func:`latest_checkpoint`: the
+            checkpoints and ``interrupted_model.zip``) up to ``total_timesteps``; a fresh start when there is
+            none.
         heuristic_prior: With ``maskable_ppo``: the initial logit of candidate ``k`` is
             ``heuristic_prior * (1 - k / K)`` (the candidates come sorted by the frontier heuristic's cost,
             so the untrained policy already prefers the heuristic's pick; 0: uniform).
@@ -110,6 +113,7 @@ class TrainConfig(Config):
     tube_penalty: float = 0.0
     algo: str = "ppo"
     heuristic_prior: float = 0.0
+    resume: bool = False
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -303,6 +307,35 @@ def build_maskable(cfg: TrainConfig, env: Any, tensorboard_log: str | None = Non
     return model
 
 
+def latest_checkpoint(out: str | Path) -> tuple[Path, int] | None:
+    """The saved model of the run in ``out`` with the most timesteps, and that count: the checkpoints
+    (``checkpoints/*.zip``) and ``interrupted_model.zip``; None when there is none."""
+    from stable_baselines3.common.save_util import load_from_zip_file
+
+    out = Path(out)
+    best: tuple[Path, int] | None = None
+    for path in [*sorted((out / "checkpoints").glob("*.zip")), out / "interrupted_model.zip"]:
+        if not path.is_file():
+            continue
+        try:
+            data, _, _ = load_from_zip_file(path, load_data=True, device="cpu")
+            steps = int((data or {}).get("num_timesteps", -1))
+        except Exception:  # noqa: BLE001 - a damaged file is not a checkpoint to resume from
+            continue
+        if steps >= 0 and (best is None or steps > best[1]):
+            best = (path, steps)
+    return best
+
+
+def load_model(cfg: TrainConfig, path: Path, env: Any, tensorboard_log: str | None = None) -> Any:
+    """The model saved at ``path`` (``cfg.algo``'s class) on ``env``, to continue training."""
+    if cfg.algo == "maskable_ppo":
+        from sb3_contrib import MaskablePPO as Algo
+    else:
+        from stable_baselines3 import PPO as Algo
+    return Algo.load(path, env=env, device=cfg.device, tensorboard_log=tensorboard_log)
+
+
 def build_model(cfg: TrainConfig, env: Any, tensorboard_log: str | None = None) -> Any:
     """The model of ``cfg`` on the vectorized ``env``: PPO with the map-state extractor, or
     :func:`build_maskable` with ``algo = "maskable_ppo"``."""
@@ -395,7 +428,11 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = N
                     verbose=cfg.verbose,
                 )
             )
-        model = build_model(cfg, env, tb)
+        last = latest_checkpoint(out) if cfg.resume else None
+        model = build_model(cfg, env, tb) if last is None else load_model(cfg, last[0], env, tb)
+        todo = cfg.total_timesteps - (last[1] if last is not None else 0)
+        if last is not None and cfg.verbose:
+            print(f"resuming from {last[0]} at {last[1]} timesteps")
         bar = _has_progress() and cfg.progress_bar
         with warnings.catch_warnings():  # Subproc training env vs Dummy eval env is intended
             warnings.filterwarnings("ignore", message="Training and eval env are not of the same type")
@@ -403,7 +440,9 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = N
             main = threading.current_thread() is threading.main_thread()
             old = signal.signal(signal.SIGINT, lambda *_: setattr(stop, "flag", True)) if main else None
             try:
-                model.learn(cfg.total_timesteps, callback=[*callbacks, stop], progress_bar=bar)
+                if todo > 0:
+                    model.learn(todo, callback=[*callbacks, stop], progress_bar=bar,
+                                reset_num_timesteps=last is None)  # fmt: skip
                 interrupted = stop.flag
             except KeyboardInterrupt:
                 interrupted = True
@@ -458,4 +497,4 @@ def _has_progress() -> bool:
 
 __all__ = ["DEFAULT_CONFIG", "EnvFactory", "SeedCycle", "TrainConfig", "TrainingInterrupted", "build_model",
            "make_vec_env", "parse_value", "pin_threads", "train", "write_sidecar", "ALGOS", "build_maskable",
-           "env_module"]  # fmt: skip
+           "env_module", "latest_checkpoint", "load_model"]  # fmt: skip

@@ -253,3 +253,25 @@ def test_maskable_ppo_trains_on_the_goal_env_from_the_heuristic_prior(tmp_path) 
     vec.close()
     path = train(cfg)
     assert path.is_file() and json.loads(path.with_suffix(".json").read_text())["env_id"] == cfg.env_id
+
+
+def test_train_resumes_from_the_latest_checkpoint(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """``resume=true`` continues the run in ``out_dir`` from the saved model with the most timesteps (a
+    checkpoint or ``interrupted_model.zip``) up to ``total_timesteps``; without one it starts afresh."""
+    from stable_baselines3 import PPO
+
+    from digslam.agents.learning.train import latest_checkpoint, train
+
+    base = ["n_envs=1", "n_steps=32", "batch_size=32", "n_epochs=1", "features_dim=16", "eval_freq=0",
+            "checkpoint_freq=32", "progress_bar=false", "env_kwargs.max_episode_steps=40",
+            f'out_dir="{tmp_path.as_posix()}"']  # fmt: skip
+    assert latest_checkpoint(tmp_path) is None
+    first = train(TrainConfig.from_file(None, [*base, "total_timesteps=64", "resume=true"]))  # nothing yet
+    assert PPO.load(first, device="cpu").num_timesteps == 64
+    path, steps = latest_checkpoint(tmp_path)
+    assert steps == 64 and path.parent.name == "checkpoints"
+    (tmp_path / "interrupted_model.zip").write_bytes(b"not a model")  # a damaged file is skipped
+    assert latest_checkpoint(tmp_path) == (path, 64)
+    final = train(TrainConfig.from_file(None, [*base, "total_timesteps=128", "resume=true"]))
+    assert PPO.load(final, device="cpu").num_timesteps == 128  # 64 more, not 128 more
+    assert latest_checkpoint(tmp_path)[1] == 128
