@@ -8,6 +8,8 @@ May import: :mod:`digslam.envs` (observations and spaces); numpy, scipy.
 """
 
 from .frontier import (
+    KEEP_FACTOR,
+    KEEP_SLACK,
     FrontierAgent,
     LawnmowerAgent,
     NavigatingAgent,
@@ -36,6 +38,8 @@ from .registry import (
 )
 
 __all__ = [
+    "KEEP_FACTOR",
+    "KEEP_SLACK",
     "BASELINES",
     "BaselinePolicy",
     "FrontierAgent",

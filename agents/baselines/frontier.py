@@ -38,6 +38,10 @@ import numpy as np
 from digslam.agents.baselines import planning as pl
 from digslam.agents.baselines.policy import BaselinePolicy, Memory, View
 
+#: Hysteresis of the goal choice: the current goal is kept while its cost is at most
+#: ``KEEP_FACTOR * best + KEEP_SLACK`` pixels (``best``: the cheapest candidate's cost).
+KEEP_FACTOR, KEEP_SLACK = 1.2, 3.0
+
 
 class NavigatingAgent(BaselinePolicy):
     """Base of the planning agents: goal choice by :meth:`_costs`, path following and bookkeeping.
@@ -155,7 +159,7 @@ class NavigatingAgent(BaselinePolicy):
             mem.goal = mem.waypoint = None
             return
         g = mem.goal
-        if g is None or not (math.isfinite(cost[g]) and cost[g] <= 1.2 * best + 3.0):  # hysteresis
+        if g is None or not (math.isfinite(cost[g]) and cost[g] <= KEEP_FACTOR * best + KEEP_SLACK):
             mem.goal = (k // cost.shape[1], k % cost.shape[1])
             mem.goal_steps = 0
             steps_per_px = self.px(view.clear.shape[0]) / (self.max_speed * self.dt)
@@ -404,6 +408,8 @@ class UncertaintyAwareFrontier(FrontierAgent):
 
 
 __all__ = [
+    "KEEP_FACTOR",
+    "KEEP_SLACK",
     "FrontierAgent",
     "LawnmowerAgent",
     "NavigatingAgent",

@@ -30,15 +30,17 @@ from typing import Any
 
 import numpy as np
 
-from digslam.agents.baselines.frontier import NavigatingAgent, UncertaintyAwareFrontier
+from digslam.agents.baselines.frontier import (
+    KEEP_FACTOR,
+    KEEP_SLACK,
+    NavigatingAgent,
+    UncertaintyAwareFrontier,
+)
 from digslam.agents.baselines.policy import Memory, View
 
 #: Candidate kinds.
 FRONTIER, CLOSURE, TURN = 0, 1, 2
 KINDS = ("frontier", "closure", "turn")
-#: The frontier agent's hysteresis (``NavigatingAgent._plan``): a goal is kept while its cost is at most
-#: ``KEEP_FACTOR * best + KEEP_SLACK`` pixels.
-KEEP_FACTOR, KEEP_SLACK = 1.2, 3.0
 
 
 @dataclass

@@ -15,11 +15,11 @@ import importlib
 import json
 from pathlib import Path
 from types import ModuleType
-from typing import Any
 
 import gymnasium as gym
 import numpy as np
 import pytest
+from goal_curves import Curve as _Curve
 
 import digslam.envs  # noqa: F401  (registers the base ids)
 from digslam.agents.baselines.registry import make_baseline
@@ -33,21 +33,6 @@ GOAL_KW = {"map_size": 36, "max_steps": 200, "step_cap": 10, "fixed_world": Fals
 @pytest.fixture(scope="module")
 def G() -> ModuleType:
     return importlib.import_module("digslam.agents.goals")
-
-
-class _Curve(gym.Wrapper):
-    """Certified coverage after every low-level step, and the actions."""
-
-    def reset(self, **kw: Any) -> Any:
-        obs, info = self.env.reset(**kw)
-        self.cov, self.actions = [info["certified_coverage"]], []
-        return obs, info
-
-    def step(self, action: Any) -> Any:
-        obs, r, te, tr, info = self.env.step(action)
-        self.cov.append(info["certified_coverage"])
-        self.actions.append(np.array(action, np.float32))
-        return obs, r, te, tr, info
 
 
 def _room(steps: int) -> _Curve:

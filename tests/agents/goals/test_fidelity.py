@@ -16,6 +16,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 import pytest
+from goal_curves import Curve as _Curve
 
 import digslam.envs  # noqa: F401  (registers the base ids)
 from digslam.agents.baselines.registry import make_baseline
@@ -24,21 +25,6 @@ from digslam.agents.evaluation.metrics import episodes_metrics
 from digslam.agents.evaluation.suite import GENERATORS
 
 SEEDS = (1_000_000, 1_000_001)
-
-
-class _Curve(gym.Wrapper):
-    """Certified coverage after every low-level step, and the actions."""
-
-    def reset(self, **kw: Any) -> Any:
-        obs, info = self.env.reset(**kw)
-        self.cov, self.actions = [info["certified_coverage"]], []
-        return obs, info
-
-    def step(self, action: Any) -> Any:
-        obs, r, te, tr, info = self.env.step(action)
-        self.cov.append(info["certified_coverage"])
-        self.actions.append(np.array(action, np.float32))
-        return obs, r, te, tr, info
 
 
 def _runs(world: str, seed: int, steps: int, step_cap: int = 100) -> dict[str, Any]:
