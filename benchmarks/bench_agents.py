@@ -7,7 +7,9 @@ change the observation, not the levels) runs on the same ``--maps`` levels of ea
 split (``digslam.envs.splits``), ``target=1.0`` (no early end), ``--steps`` steps
 (:func:`digslam.agents.evaluation.suite.run_suite`). Prints the leaderboard (T90 per generator with its
 success rate, T90 / AUC / final tube over all maps, and the ratio to the best baseline with its paired
-bootstrap 95 % interval), writes ``leaderboard.md``, ``leaderboard.png`` and ``suite.json`` to ``--out``,
+bootstrap 95 % interval), writes ``leaderboard.md``, ``leaderboard.png``, ``suite.json`` and ``best.json``
+(the best agent overall, learned ones included; copied to ``agents/data/leaderboard.json`` it becomes
+``digslam demo``'s default agent) to ``--out``,
 then prints ``heuristic_t90_success=<share of the test maps, over all generators, on which the best
 baseline reaches 0.9 certified coverage>`` and ``eval_steps_per_s=<observed env steps per second with the
 frontier agent, one process>``; with a learned model it ends with ``speedup_t95=`` and
@@ -27,6 +29,7 @@ cluster at ``--address``) with identical results; ``eval_steps_per_s`` is still 
 from __future__ import annotations
 
 import argparse
+import json
 import time
 from pathlib import Path
 from typing import Any
@@ -38,6 +41,7 @@ from digslam.agents.baselines.registry import BASELINES, make_baseline
 from digslam.agents.evaluation.metrics import paired_bootstrap_geomean
 from digslam.agents.evaluation.ray_eval import run_suite_ray
 from digslam.agents.evaluation.suite import run_suite, steps_per_second
+from digslam.agents.learning.models import leaderboard_record
 
 ENV_ID = "digslam/DigCoverage-v0"
 MODEL = Path(__file__).resolve().parents[1] / "agents" / "data" / "ppo_digcoverage.zip"
@@ -110,11 +114,22 @@ def main() -> None:
     (args.out / "leaderboard.md").write_text(table + "\n")
     print(f"wrote {args.out / 'leaderboard.md'}, {res.figure(args.out / 'leaderboard.png')} and "
           f"{res.to_json(args.out / 'suite.json')}")  # fmt: skip
+    best = res.best(list(BASELINES) + (["ppo"] if "ppo" in res.agents else []))
+    record = leaderboard_record(best, float(res.t90()[best].mean()), maps, steps, list(res.results))
+    (args.out / "best.json").write_text(
+        json.dumps(record, indent=2) + "\n"
+    )  # the shipped copy: models.LEADERBOARD
+    print(f"wrote {args.out / 'best.json'} (best agent overall: {best})")
     best = res.best(list(BASELINES))
     rate = steps_per_second(policies["frontier"], ENV_ID, steps=min(2000, 10 * steps))
     print(f"best_baseline={best}")
     print(f"heuristic_t90_success={res.success(best):.4f}")
     print(f"eval_steps_per_s={rate:.0f}")
+    if ppo is not None and callable(getattr(ppo, "choice_stats", None)):  # a goal-level model: its choices
+        st = ppo.choice_stats()
+        print(f"learned_choices: {st['decisions']:.0f} decisions, {100 * st['not_first']:.1f} % differ from the "
+              f"frontier agent's pick; frontier {100 * st['frontier']:.1f} %, loop closure "
+              f"{100 * st['closure']:.1f} %, turn in place {100 * st['turn']:.1f} %")  # fmt: skip
     if ppo is not None:  # the learned agent (--model): geometric mean over the maps of T(best) / T(learned)
         for level in ("T95", "T90"):
             t = res.t90(level)

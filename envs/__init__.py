@@ -23,6 +23,7 @@ from digslam.envs.explore.truth import GroundTruth
 from digslam.envs.sim.generators import (
     Caves,
     FileMap,
+    Mixed,
     RockField,
     RoomsCorridors,
     ThesisRoom,
@@ -119,6 +120,7 @@ __all__ = [
     "ExploreConfig",
     "ExploreEnv",
     "FileMap",
+    "Mixed",
     "GroundTruth",
     "NoiseConfig",
     "RockField",

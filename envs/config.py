@@ -24,7 +24,7 @@ from digslam.observer.core.config import (
 )
 
 NOISE_MODELS = ("uniform", "adversarial", "biased")
-WORLDS = ("room", "rocks", "caves", "rooms", "file")
+WORLDS = ("room", "rocks", "caves", "rooms", "file", "mixed")
 #: How the robot moves (:mod:`digslam.envs.sim.robot`): pymunk rigid-body dynamics or exact unicycle arcs.
 DYNAMICS = ("pymunk", "unicycle")
 #: How a reset picks the start pose when ``start`` is None.
@@ -78,7 +78,8 @@ class ExploreConfig(Config):
     """Configuration of ``digslam/Explore-v0``.
 
     Attributes:
-        world: Generator name, one of ``room`` (thesis Fig. 6.10), ``rocks``, ``caves``, ``rooms``, ``file``.
+        world: Generator name, one of ``room`` (thesis Fig. 6.10), ``rocks``, ``caves``, ``rooms``, ``file``,
+            or ``mixed`` (each level from one of the first four, drawn from its seed: training across them).
         world_size: Half-width of the square frame (m); the frame is ``[-s, s]^2``.
         n_obstacles: Number of rocks (``world='rocks'``).
         map_path: Polygon (``.json``/``.npz``) or image file for ``world="file"``.

@@ -19,6 +19,12 @@ either way.
 * loop closure (:class:`UncertaintyAwareFrontier`): pixels next to sensed obstacles (penumbra) that the
   robot passed while its tube was at most half as wide as now.
 
+Two ways an episode used to stop for good, now handled (``rooms``, validation levels): with every clear
+pixel visited, the unexplored may lie beyond a corridor seen only in penumbra, so the penumbra pixels next to
+dark ground become goals (``penumbra_frontier``); and a robot that drives without moving (pressed into a
+door frame the map showed as free) blocks the pixel ahead and backs off (``unstick``). A waypoint so close
+that the driver counts it as reached at once is moved one pixel on along the path.
+
 >>> from gymnasium import spaces
 >>> agent = FrontierAgent(spaces.Box(-1, 1, (2,)))
 >>> state = np.zeros(11, np.float32); state[[4, 10]] = 1.0; state[8] = 0.1    # centre, heading +x
@@ -41,6 +47,9 @@ from digslam.agents.baselines.policy import BaselinePolicy, Memory, View
 #: Hysteresis of the goal choice: the current goal is kept while its cost is at most
 #: ``KEEP_FACTOR * best + KEEP_SLACK`` pixels (``best``: the cheapest candidate's cost).
 KEEP_FACTOR, KEEP_SLACK = 1.2, 3.0
+#: Stall detection (:meth:`NavigatingAgent._stalled`): over ``STALL_STEPS`` driving steps the robot covered
+#: less than ``STALL_SHARE`` of the commanded distance; it then backs off for ``BACK_STEPS`` steps.
+STALL_STEPS, STALL_SHARE, BACK_STEPS = 8, 0.25, 3
 
 
 class NavigatingAgent(BaselinePolicy):
@@ -58,6 +67,8 @@ class NavigatingAgent(BaselinePolicy):
             T90 1777 against 1867 steps, 0.9 reached on 62 % of them against 56 %).
         soft: Plan over every pixel not dark with the costs of :meth:`weights` (module docstring).
         edge_weight: Cost of a clear pixel that the erosion removed (soft planning).
+        unstick: Detect a stall (driving without moving, :meth:`_stalled`), block the pixel ahead and back
+            off; off, a robot pressed into a door frame pushes on until its goal's step budget runs out.
         **kw: :class:`BaselinePolicy` arguments.
     """
 
@@ -73,8 +84,10 @@ class NavigatingAgent(BaselinePolicy):
         penumbra_weight: float = 3.0,
         soft: bool = True,
         edge_weight: float = 2.0,
+        unstick: bool = True,
         **kw: Any,
     ) -> None:
+        self.unstick = bool(unstick)
         for name, v in (("penumbra_weight", penumbra_weight), ("edge_weight", edge_weight)):
             if not (math.isfinite(v) and v >= 1.0):
                 raise ValueError(f"{name}: must be finite and >= 1, got {v!r}")
@@ -98,9 +111,47 @@ class NavigatingAgent(BaselinePolicy):
         """Called when the robot reaches its goal pixel."""
 
     # --- the loop ----------------------------------------------------------------------------------------
+    def _stalled(self, view: View, mem: Memory) -> bool:
+        """Whether the robot, driving straight over the last :data:`STALL_STEPS` steps, covered less than
+        :data:`STALL_SHARE` of the commanded distance (pressed into an obstacle the map showed as free
+        room: a door frame, a corner the erosion missed). The pixel ahead is then marked blocked (never
+        planned over again), the goal and waypoint are dropped and the robot backs off for
+        :data:`BACK_STEPS` steps."""
+        if not self.unstick or not mem.moving:
+            mem.drives.clear()
+            return False
+        mem.drives.append(
+            (view.pos.copy(), mem.last_v * self.max_speed * self.dt / self.px(view.clear.shape[0]))
+        )
+        if len(mem.drives) <= STALL_STEPS:
+            return False
+        del mem.drives[0]
+        moved = float(np.hypot(*(mem.drives[-1][0] - mem.drives[0][0])))
+        if moved >= STALL_SHARE * sum(v for _, v in mem.drives[1:]):
+            return False
+        ahead = view.pos + np.array([-math.sin(view.heading), math.cos(view.heading)])
+        block = self._disk(view.clear.shape[0], ahead, 0.75)
+        block[view.cell] = False
+        mem.blocked |= block
+        mem.drives.clear()
+        mem.goal = mem.waypoint = None
+        mem.moving, mem.backing = False, BACK_STEPS
+        return True
+
+    def _recover(self, view: View, mem: Memory) -> np.ndarray | None:
+        """The backing-off action while recovering from a stall (:meth:`_stalled`), else None."""
+        if mem.backing > 0 or self._stalled(view, mem):
+            mem.backing -= 1
+            mem.last_v = 0.0
+            return np.array([-0.5, 0.0], dtype=np.float32)
+        return None
+
     def _act(self, view: View, mem: Memory) -> np.ndarray:
         m = view.clear.shape[0]
         px = self.px(m)
+        back = self._recover(view, mem)
+        if back is not None:
+            return back
         near = self._disk(m, view.pos, self.visit_radius / px)
         mem.visited |= near
         mem.best_tube[near] = np.minimum(mem.best_tube[near], view.tube)
@@ -114,7 +165,9 @@ class NavigatingAgent(BaselinePolicy):
             self._plan(view, mem)
         mem.age += 1
         mem.goal_steps += 1
-        return self._drive(view, mem)
+        action = self._drive(view, mem)
+        mem.last_v = float(action[0]) if mem.moving else 0.0
+        return action
 
     def traversable(self, view: View) -> np.ndarray:
         """Clear pixels eroded by ``margin`` plus half the tube width (the true robot may be anywhere in
@@ -130,18 +183,19 @@ class NavigatingAgent(BaselinePolicy):
         mem.age = 0
         cell = view.cell
         if self.soft:
-            eroded = self.traversable(view)
+            eroded = self.traversable(view) & ~mem.blocked
             weight = self.weights(view, eroded)
+            weight[mem.blocked] = np.inf
             trav = np.isfinite(weight)
             dist, pred = pl.shortest_paths(trav, cell, np.where(trav, weight, 1.0))
             cost = self._costs(view, mem, np.isfinite(dist) & view.clear, dist)
             cost[cell] = np.inf
         else:
-            trav = self.traversable(view)
+            trav = self.traversable(view) & ~mem.blocked
             dist, pred = pl.shortest_paths(trav, cell)
             reach = np.isfinite(dist)
             if np.count_nonzero(reach) <= 1:  # boxed in by the erosion: plan over the plain clear pixels
-                trav = view.clear
+                trav = view.clear & ~mem.blocked
                 dist, pred = pl.shortest_paths(trav, cell)
                 reach = np.isfinite(dist)
             cost = self._costs(view, mem, reach, dist)
@@ -149,7 +203,7 @@ class NavigatingAgent(BaselinePolicy):
             if not np.isfinite(cost).any() and self.cautious:
                 # nothing over the clear ground (e.g. a map too coarse for a narrow passage): cross
                 # penumbra, at a cost, towards the same kind of goals
-                trav = ~view.dark
+                trav = ~view.dark & ~mem.blocked
                 dist, pred = pl.shortest_paths(trav, cell, np.where(view.clear, 1.0, self.penumbra_weight))
                 cost = self._costs(view, mem, np.isfinite(dist), dist)
                 cost[cell] = np.inf
@@ -172,6 +226,8 @@ class NavigatingAgent(BaselinePolicy):
             on_path[path[:, 0], path[:, 1]] = True
             sight |= on_path
         j = pl.line_of_sight(sight, start, path)
+        while j + 1 < len(path) and float(np.hypot(*(path[j] + 0.5 - view.pos))) < 0.75:
+            j += 1  # a waypoint that _drive counts as reached at once would stop the robot for good
         mem.waypoint = path[j].astype(np.float64) + 0.5
 
     def weights(self, view: View, eroded: np.ndarray | None = None) -> np.ndarray:
@@ -194,6 +250,10 @@ class FrontierAgent(NavigatingAgent):
         turn_weight: Weight of the time to turn in place towards a goal, counted as the distance that
             could be driven meanwhile (a half turn takes as long as 3 m of driving at full scale); 4 was
             the best of 0-8 on the maps of seeds 0-2, taking about a fifth fewer steps to 0.8 than 0.
+        penumbra_frontier: When no clear pixel is a candidate, take the reachable penumbra pixels next to
+            dark ground not yet visited, those farther from clear ground than the tube's band along walls
+            first (at the ``unvisited_penalty``): a corridor that the cones saw only in penumbra is otherwise
+            never entered.
         **kw: :class:`NavigatingAgent` arguments.
     """
 
@@ -205,8 +265,10 @@ class FrontierAgent(NavigatingAgent):
         penumbra_penalty: float = 6.0,
         unvisited_penalty: float = 12.0,
         turn_weight: float = 4.0,
+        penumbra_frontier: bool = True,
         **kw: Any,
     ) -> None:
+        self.penumbra_frontier = bool(penumbra_frontier)
         named = (("penumbra_penalty", penumbra_penalty), ("unvisited_penalty", unvisited_penalty),
                  ("turn_weight", turn_weight))  # fmt: skip
         for name, v in named:
@@ -227,6 +289,14 @@ class FrontierAgent(NavigatingAgent):
         cost[free] = dist[free] + self.unvisited_penalty / px
         cost[pen] = dist[pen] + self.penumbra_penalty / px
         cost[dark] = dist[dark]
+        if self.penumbra_frontier and not np.isfinite(cost).any():
+            # no clear goal left: the unexplored may lie beyond a passage seen only in penumbra (a corridor
+            # that the sonar cones, cut short by its walls, never cleared); go to its edge with dark ground,
+            # deeper in the penumbra than the band that the tube puts along every wall first, then any
+            edge = np.isfinite(dist) & view.penumbra & pl.dilate(view.dark, 1) & ~mem.visited
+            deep = edge & ~pl.dilate(view.clear, int(math.ceil(view.tube / px)) + 2)
+            edge = deep if deep.any() else edge
+            cost[edge] = dist[edge] + self.unvisited_penalty / px
         if self.turn_weight > 0:
             m = view.clear.shape[0]
             rr, cc = np.mgrid[:m, :m] + 0.5

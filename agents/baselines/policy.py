@@ -77,10 +77,15 @@ class Memory:
     goal_budget: int = 0
     t: int = 0
     extra: dict[str, Any] = field(default_factory=dict)
+    blocked: np.ndarray = field(init=False)  # pixels where the robot drove and did not move (never planned)
+    drives: list[tuple[np.ndarray, float]] = field(default_factory=list)  # (position, speed) of recent drives
+    backing: int = 0  # steps of reversing left after a stall
+    last_v: float = 0.0  # normalised speed of the last action while driving (0 when turning)
 
     def __post_init__(self) -> None:
         self.visited = np.zeros((self.m, self.m), dtype=bool)
         self.best_tube = np.full((self.m, self.m), np.inf)
+        self.blocked = np.zeros((self.m, self.m), dtype=bool)
 
 
 class BaselinePolicy:

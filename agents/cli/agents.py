@@ -21,10 +21,11 @@ from digslam.agents.learning import models
 
 
 def agent_names() -> list[str]:
-    """Names ``--agent`` takes: ``ppo`` and the baselines."""
+    """Names ``--agent`` takes: ``best`` (the leaderboard's best, :func:`~.models.best_agent`), ``ppo`` and
+    the baselines."""
     from digslam.agents.baselines.registry import BASELINES
 
-    return ["ppo", *BASELINES]
+    return ["best", "ppo", *BASELINES]
 
 
 def model_env_kwargs(model: Path | None = None) -> dict[str, Any]:
@@ -54,7 +55,9 @@ def load_agent(name: str, env: Any, model: Path | None = None) -> Any:
     """
     if name == "ppo":
         return load_ppo(Path(model) if model is not None else models.PRETRAINED, env)
-    if name not in agent_names():
+    if name == "best":
+        name = models.best_agent()[0]
+    if name not in agent_names() or name == "best":
         raise UserError(f"--agent {name!r}: unknown agent; known: {', '.join(agent_names())}")
     from digslam.agents.baselines.registry import make_baseline
 
@@ -62,11 +65,18 @@ def load_agent(name: str, env: Any, model: Path | None = None) -> Any:
 
 
 def resolve_agent(name: str, env_id: str, model: Path | None) -> tuple[str, Any, dict[str, Any]]:
-    """``(name, policy, env_kwargs)``. A ``--model`` the user names must load (:class:`UserError`
-    otherwise); without one, ``"ppo"`` falls back to ``"frontier"`` (with a warning) when the shipped policy,
-    torch or stable-baselines3 is unavailable."""
+    """``(name, policy, env_kwargs)``. ``"best"`` is the leaderboard's best agent
+    (:func:`~.models.best_agent`; printed with the reason), or ``"ppo"`` when a ``model`` is given. A
+    ``--model`` the user names must load (:class:`UserError` otherwise); without one, ``"ppo"`` falls back to
+    ``"frontier"`` (with a warning) when the shipped policy, torch or stable-baselines3 is unavailable."""
     if name not in agent_names():
         raise UserError(f"--agent {name!r}: unknown agent; known: {', '.join(agent_names())}")
+    if name == "best" and model is not None:  # a model named on its own is the agent to run
+        name = "ppo"
+    if name == "best":  # the leaderboard's best agent, and the line that says so
+        best, why = models.best_agent()
+        print(f"--agent best: {best}, {why}")
+        name = best if best in agent_names() and best != "best" else "frontier"
     if model is not None and name != "ppo":
         raise UserError(f"--model: only with --agent ppo (got --agent {name})")
     pretrained = models.PRETRAINED  # read at call time (tests point it elsewhere)

@@ -100,6 +100,7 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         require_ray("--ray" if args.ray else "--address/--ray-cpus")
     check_env_id(args.env, "evaluate")
     out = out_path(args.out, "--out")
+    args.agents = [models.best_agent()[0] if a == "best" else a for a in args.agents]
     for a in args.agents:
         if a not in agent_names():
             raise UserError(f"--agents: unknown agent {a!r}; known: {', '.join(agent_names())}")

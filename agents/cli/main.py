@@ -1,8 +1,9 @@
 """The ``digslam`` command: demo, train, evaluate, record, replay, sweep, warmup and benchmark.
 
-``digslam demo`` runs ``digslam/DigCoverage-v0`` with the pretrained PPO policy shipped in
-``digslam/agents/data`` (the frontier agent if the model or torch is unavailable), writes the episode GIF
-and the certified-coverage figure to ``--out`` and prints the certified coverage reached. Every
+``digslam demo`` runs ``digslam/DigCoverage-v0`` with the best agent of the leaderboard shipped in
+``digslam/agents/data/leaderboard.json`` (``--agent best``, the default; it prints which agent that is and
+why; ``--agent ppo`` runs the shipped PPO policy), writes the episode GIF and the certified-coverage figure
+to ``--out`` and prints the certified coverage reached. Every
 subcommand has ``--help``; heavy imports (torch, SB3, matplotlib) happen only when a subcommand needs them.
 
 :func:`main` is the entry point (also ``python -m digslam.agents.cli.main``); the command line is split over

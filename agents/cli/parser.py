@@ -17,8 +17,9 @@ from digslam.agents.learning.models import DEFAULT_ENV
 def agent_options(p: argparse.ArgumentParser, default: str) -> None:
     """Add ``--agent`` (default ``default``), ``--model``, ``--env`` and ``--seed`` to ``p``."""
     p.add_argument("--agent", default=default,
-                   help="ppo (the pretrained policy) or a baseline: random, lawnmower, frontier, "
-                        "uncertainty_frontier (default %(default)s)")  # fmt: skip
+                   help="best (the best agent of the shipped leaderboard), ppo (the pretrained policy) or "
+                        "a baseline: random, lawnmower, frontier, uncertainty_frontier "
+                        "(default %(default)s)")  # fmt: skip
     p.add_argument("--model", default=None, help="saved PPO model (.zip) instead of the shipped one")
     p.add_argument("--env", default=DEFAULT_ENV, help="environment id (default %(default)s)")
     p.add_argument("--seed", type=int, default=0, help="episode seed (default %(default)s)")
@@ -30,8 +31,10 @@ def build_parser() -> argparse.ArgumentParser:
                                  "training, evaluation and episode tools.")  # fmt: skip
     sub = ap.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = sub.add_parser("demo", help="run the pretrained policy; write a GIF and the coverage figure")
-    agent_options(p, "ppo")
+    p = sub.add_parser(
+        "demo", help="run the best agent of the leaderboard; write a GIF and the coverage figure"
+    )
+    agent_options(p, "best")
     p.add_argument("--steps", type=int, default=600, help="episode length (default %(default)s)")
     p.add_argument("--fps", type=int, default=15, help="GIF frames per second (default %(default)s)")
     p.add_argument("--stride", type=int, default=2, help="keep every STRIDE-th frame (default %(default)s)")

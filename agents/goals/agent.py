@@ -134,6 +134,7 @@ class GoalAgent:
         params = _params(chooser.predict)
         self._masks = "action_masks" in params or "**" in params
         self._det = "deterministic" in params or "**" in params
+        self.choices: dict[str, int] = {}  # over every episode since construction (:meth:`choice_stats`)
         self.reset()
 
     @classmethod
@@ -256,7 +257,19 @@ class GoalAgent:
         if not 0 <= i < self.n or not c.mask[i]:
             valid = np.flatnonzero(c.mask).tolist()
             raise ValueError(f"chooser: candidate {i} is out of range or masked out (valid: {valid})")
+        for key in ("decisions", KINDS[int(c.kind[i])]) + (("not_first",) if i else ()):
+            self.choices[key] = self.choices.get(key, 0) + 1
         return i
+
+    def choice_stats(self) -> dict[str, float]:
+        """Over every decision since construction (episodes included; :meth:`reset` keeps them): the count
+        of decisions, the share that differ from the frontier agent's pick (``not_first``: not candidate
+        0), and the share of each kind chosen (``frontier``, ``closure``: back to close a loop, ``turn``)."""
+        n = self.choices.get("decisions", 0)
+        out: dict[str, float] = {"decisions": float(n)}
+        for key in ("not_first", *KINDS):
+            out[key] = self.choices.get(key, 0) / n if n else 0.0
+        return out
 
 
 def _params(fn: Any) -> set[str]:

@@ -119,7 +119,8 @@ def candidates(driver: GoalDriver, view: View, mem: Memory, n: int = 16) -> Cand
     # the frontier agent drives on to its goal until a re-plan is due, then keeps it by its hysteresis
     drives_on = mem.waypoint is not None and mem.age < driver.replan_every
     keep_goal = (x["ended"] == "cap" and x["kind"] == FRONTIER and g is not None and g == x["goal"]
-                 and bool(plan.reach[g]) and (drives_on or regret(cost, g) <= 0.0))  # fmt: skip
+                 and bool(plan.reach[g] or np.isfinite(cost[g]))  # a penumbra frontier is reachable too
+                 and (drives_on or regret(cost, g) <= 0.0))  # fmt: skip
     tier = tiers(driver, view, mem, plan.reach)
     fr = [clusters((tier == t) & np.isfinite(cost), cost) for t in (1, 2, 3)]
     reps = np.concatenate([f[0] for f in fr])

@@ -90,14 +90,14 @@ class GoalDriver(UncertaintyAwareFrontier):
 
     def probe(self, view: View, mem: Memory) -> Plan:
         """The bookkeeping of one step and one planning pass on ``view``, the goal state left as it was."""
-        saved = (mem.goal, mem.waypoint, mem.moving, mem.age, mem.goal_steps, mem.goal_budget)
+        saved = (mem.goal, mem.waypoint, mem.moving, mem.age, mem.goal_steps, mem.goal_budget, mem.last_v)
         mem.goal = mem.waypoint = None
         mem.extra["probe"] = True
         try:
             NavigatingAgent._act(self, view, mem)
         finally:
             mem.extra["probe"] = False
-            mem.goal, mem.waypoint, mem.moving, mem.age, mem.goal_steps, mem.goal_budget = saved
+            mem.goal, mem.waypoint, mem.moving, mem.age, mem.goal_steps, mem.goal_budget, mem.last_v = saved
         return mem.extra.pop("plan")
 
     def start(self, mem: Memory, kind: int, goal: tuple[int, int], slack: float = 0.0, keep: bool = False,
@@ -118,10 +118,11 @@ class GoalDriver(UncertaintyAwareFrontier):
         x["event"] = None
         if x["kind"] == TURN and x["turned"] >= self.n_turn:
             x["event"] = "turned"
-        moving = mem.moving
+        saved = (mem.moving, list(mem.drives), mem.backing, mem.last_v, mem.blocked.copy())
         action = NavigatingAgent._act(self, view, mem)
-        if x["event"] is not None:  # the action is dropped: so is its controller state (turning or driving)
-            mem.moving = moving
+        if x["event"] is not None:  # the action is dropped: so is its controller state (turning or driving,
+            # and the stall watch, which the next macro step's first action runs again on this same view)
+            mem.moving, mem.drives, mem.backing, mem.last_v, mem.blocked = saved
         elif x["kind"] == TURN:
             x["turned"] += 1
         return np.clip(action, -1.0, 1.0).astype(np.float32), x["event"]
@@ -138,6 +139,9 @@ class GoalDriver(UncertaintyAwareFrontier):
     # --- NavigatingAgent's hooks -------------------------------------------------------------------------
     def _act(self, view: View, mem: Memory) -> np.ndarray:
         return NavigatingAgent._act(self, view, mem)
+
+    def _recover(self, view: View, mem: Memory) -> np.ndarray | None:
+        return None if mem.extra["probe"] else super()._recover(view, mem)
 
     def _plan(self, view: View, mem: Memory) -> None:
         x = mem.extra
@@ -173,7 +177,9 @@ class GoalDriver(UncertaintyAwareFrontier):
         elif kind == TURN:
             if x["watch"] and np.isfinite(cost).any():
                 x["event"] = "frontier"
-        elif not reach[g]:
+        elif not (
+            reach[g] or kind == FRONTIER and math.isfinite(cost[g])
+        ):  # a penumbra frontier is reachable
             x["event"] = "unreachable"
         elif kind == FRONTIER and mem.visited[g]:
             x["event"] = "reached"

@@ -33,14 +33,18 @@ from typing import Any
 DATA = Path(__file__).parents[1] / "data"
 #: The shipped policy; the environment keywords it was trained with are in ``<model>.json``.
 PRETRAINED = DATA / "ppo_digcoverage.zip"
+#: The best agent of the last full leaderboard run (``benchmarks/bench_agents.py`` writes ``best.json`` to
+#: its ``--out``; the shipped copy lives here): ``digslam demo``'s default agent (:func:`best_agent`).
+LEADERBOARD = DATA / "leaderboard.json"
 #: The environment the shipped policy was trained on (the default of every command that runs an agent).
 DEFAULT_ENV = "digslam/DigCoverage-v0"
 
 
 #: The package of the goal-selection envs (:func:`~.train.env_module` of their ids).
 GOALS = "digslam.agents.goals"
-#: Environment keywords of a training run that are no part of what the model sees.
-TRAINING_ONLY = ("fixed_world", "max_episode_steps", "render_mode")
+#: Environment keywords of a training run that are no part of what the model sees (the levels it trained
+#: on among them: each command picks its own, the benchmark each generator of its suite).
+TRAINING_ONLY = ("fixed_world", "max_episode_steps", "render_mode", "world", "map_seed")
 
 
 class ModelError(ValueError):
@@ -90,6 +94,27 @@ def _goals() -> Any:
     import digslam.agents.goals as goals
 
     return goals
+
+
+def best_agent(path: str | Path | None = None) -> tuple[str, str]:
+    """``(agent, why)``: the best agent of the leaderboard file ``path`` (None: :data:`LEADERBOARD`), the
+    agent name the benchmark ranked first by mean T90 over the test maps of every generator, and a line
+    saying where that comes from; ``("frontier", ...)`` when the file is missing or damaged."""
+    path = Path(path) if path is not None else LEADERBOARD
+    try:
+        data = json.loads(path.read_text())
+        name = str(data["best"])
+        t90, maps, gens = float(data["T90_mean"]), int(data["maps"]), len(data["generators"])
+        why = f"mean T90 {t90:.0f} steps over {maps} test maps x {gens} generators"
+        return name, f"best on the leaderboard ({path.name}: {why})"
+    except (OSError, ValueError, KeyError, TypeError):
+        return "frontier", f"no readable leaderboard at {path}; the frontier agent"
+
+
+def leaderboard_record(best: str, t90_mean: float, maps: int, steps: int, generators: list[str]) -> dict:
+    """The content of a leaderboard file (:func:`best_agent` reads it back)."""
+    return {"best": best, "T90_mean": float(t90_mean), "maps": int(maps), "steps": int(steps),
+            "generators": list(generators), "split": "test"}  # fmt: skip
 
 
 def model_env_kwargs(model: str | Path | None = None) -> dict[str, Any]:
@@ -192,5 +217,6 @@ def _goal_agent(model: Any, path: Path, env: Any, meta: dict[str, Any], opt: str
     return agent
 
 
-__all__ = ["DATA", "DEFAULT_ENV", "GOALS", "PRETRAINED", "TRAINING_ONLY", "ModelError", "as_policy",
-           "goal_env_id", "load_ppo", "model_env_kwargs", "model_meta"]  # fmt: skip
+__all__ = ["DATA", "DEFAULT_ENV", "GOALS", "LEADERBOARD", "PRETRAINED", "TRAINING_ONLY", "ModelError",
+           "as_policy", "best_agent", "goal_env_id", "leaderboard_record", "load_ppo", "model_env_kwargs",
+           "model_meta"]  # fmt: skip

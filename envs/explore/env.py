@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 import gymnasium as gym
@@ -65,6 +66,9 @@ def _generator(cfg: ExploreConfig) -> WorldGenerator:
         return GENERATORS["rocks"](size=cfg.world_size, n=cfg.n_obstacles)  # type: ignore[call-arg]
     if cfg.world == "room":
         return GENERATORS["room"](size=cfg.world_size, jitter=cfg.room_jitter)  # type: ignore[call-arg]
+    if cfg.world == "mixed":  # each of the suite's generators with the settings it gets on its own
+        each = tuple(_generator(replace(cfg, world=w)) for w in ("room", "rocks", "caves", "rooms"))
+        return GENERATORS["mixed"](each, size=cfg.world_size)  # type: ignore[call-arg]
     return GENERATORS[cfg.world](size=cfg.world_size)
 
 

@@ -2,8 +2,8 @@
 
 Lives here, in data-flow order: :mod:`.world` (``World``: polygonal obstacles and a raster), :mod:`.tracing`
 (marching squares), :mod:`.raster`, :mod:`.generators` (``ThesisRoom``, ``RockField``, ``Caves``,
-``RoomsCorridors``, ``FileMap``), :mod:`.geometry` and :mod:`.geometry_jit` (rigorous point-edge and sector
-distances), :mod:`.arc_jit` (the exact arc of one piece of motion and its proved error bound),
+``RoomsCorridors``, ``FileMap``, ``Mixed``), :mod:`.geometry` and :mod:`.geometry_jit` (rigorous point-edge
+and sector distances), :mod:`.arc_jit` (the exact arc of one piece of motion and its proved error bound),
 :mod:`.robot` and :mod:`.robot_jit` (``RobotSim``: pymunk dynamics or exact unicycle arcs),
 :mod:`.dynamics_jit` (the pymunk robot's premise guard, substep durations and velocity bounds),
 :mod:`.sensors` (``SensorSuite``: sonars, omnidirectional range, odometry, compass), :mod:`.noise` and
@@ -32,6 +32,7 @@ from .generators import (
     THESIS_ROOM,
     Caves,
     FileMap,
+    Mixed,
     RockField,
     RoomsCorridors,
     ThesisRoom,
@@ -114,6 +115,7 @@ __all__ = [
     "FRACTIONS",
     "FREE",
     "FileMap",
+    "Mixed",
     "GENERATORS",
     "Hull",
     "MIXED",

@@ -263,12 +263,36 @@ class FileMap(WorldGenerator):
         return World.from_edges(self.frame, mask_edges(free, self.frame), self.path.stem)
 
 
+class Mixed(WorldGenerator):
+    """Each level from one of ``generators`` (room, rocks, caves, rooms by default), drawn from the level's
+    seed (uniformly), then built by that generator from the same random stream: one env id over every
+    generator of the coverage suite, for training across them. The same seed gives the same world.
+
+    Args:
+        generators: The generators to draw from (built by the caller with their own settings).
+    """
+
+    name = "mixed"
+
+    def __init__(self, generators: tuple[WorldGenerator, ...] = (), size: float = 10.0, **kw: float) -> None:
+        super().__init__(size, **kw)
+        self.generators = tuple(generators) or (ThesisRoom(size), RockField(size), Caves(size),
+                                                RoomsCorridors(size))  # fmt: skip
+        for g in self.generators:
+            if g.frame != self.frame:
+                raise ValueError(f"generators: {g.name} has frame {g.frame}, expected {self.frame}")
+
+    def _gen_world(self, rng: np.random.Generator) -> World:
+        return self.generators[int(rng.integers(len(self.generators)))]._gen_world(rng)
+
+
 GENERATORS: dict[str, type[WorldGenerator]] = {
     "room": ThesisRoom,
     "rocks": RockField,
     "caves": Caves,
     "rooms": RoomsCorridors,
     "file": FileMap,
+    "mixed": Mixed,
 }
 
 
@@ -276,6 +300,7 @@ __all__ = [
     "Caves",
     "FileMap",
     "GENERATORS",
+    "Mixed",
     "RockField",
     "RoomsCorridors",
     "THESIS_ROOM",

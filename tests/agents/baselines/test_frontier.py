@@ -10,6 +10,7 @@ import pytest
 from gymnasium import spaces
 
 import digslam.envs  # noqa: F401  (registers the env ids)
+from digslam.agents.baselines.frontier import BACK_STEPS, STALL_STEPS, FrontierAgent
 from digslam.agents.baselines.registry import BASELINES, UncertaintyAwareFrontier, make_baseline
 from digslam.envs.sim.generators import GENERATORS
 
@@ -105,3 +106,54 @@ def test_uncertainty_aware_frontier_survives_the_rooms_episode_that_crashed(seed
     assert extra.get("exhausted", 0) >= 1  # the path that crashed was taken
     assert info["consistent"]
     env.close()
+
+
+def test_with_every_clear_pixel_visited_the_goal_is_the_far_end_of_a_penumbra_corridor() -> None:
+    """A room seen in full and a corridor out of it seen only in penumbra (the cones, cut short by its walls,
+    never cleared it), dark beyond: once the room is visited, the goal is the corridor's edge with the dark
+    ground (``penumbra_frontier``), not the penumbra band along the room's walls; without it there is no goal at
+    all (the stall on ``rooms``)."""
+    clear = np.zeros((36, 36), bool)
+    clear[10:26, 4:16] = True
+    dark = np.ones_like(clear)
+    dark[8:28, 2:18] = False  # the room and its walls' penumbra
+    dark[16:20, 18:26] = False  # the corridor, penumbra, ending at dark column 26
+    goals = {}
+    for on in (True, False):
+        agent = FrontierAgent(BOX, span=36.0, penumbra_frontier=on)
+        agent.predict(_obs(clear, dark, (18.5, 9.5), tube=0.05))
+        mem = agent._mem[0]
+        mem.visited[clear] = True  # the whole room explored
+        mem.goal = mem.waypoint = None
+        agent.predict(_obs(clear, dark, (18.5, 9.5), tube=0.05))
+        goals[on] = mem.goal
+    assert goals[False] is None
+    g = goals[True]
+    assert g is not None and 16 <= g[0] < 20 and 18 < g[1] <= 25  # in the corridor, not the room's wall band
+
+
+def test_a_robot_driving_without_moving_blocks_the_pixel_ahead_and_backs_off() -> None:
+    """Pressed into an obstacle that the map shows as free (the observation stays the same while the agent
+    drives): after ``STALL_STEPS`` driving steps the pixel ahead is blocked for the planner, the goal is
+    dropped and the robot reverses for ``BACK_STEPS`` steps; with ``unstick=False`` it pushes on."""
+    clear = np.zeros((36, 36), bool)
+    clear[4:32, 4:32] = True
+    dark = np.zeros_like(clear)
+    dark[:, 33:] = True
+    obs = _obs(clear, dark, (18.5, 10.5), tube=0.05)  # heading +x (state[4] = cos = 1), frontier to the east
+    for unstick in (True, False):
+        agent = FrontierAgent(BOX, span=36.0, visit_radius=0.5, unstick=unstick)
+        actions = [agent.predict(obs)[0] for _ in range(STALL_STEPS + 1 + BACK_STEPS)]
+        mem = agent._mem[0]
+        driving = [i for i, a in enumerate(actions) if a[0] > 0]
+        assert driving, "the agent never drove towards the frontier"
+        if unstick:
+            first = driving[0]
+            reverse = [i for i, a in enumerate(actions) if a[0] < 0]
+            assert reverse and reverse[0] == first + STALL_STEPS + 1  # STALL_STEPS steps of driving seen
+            assert all(actions[i][0] < 0 for i in range(reverse[0], reverse[0] + BACK_STEPS))
+            assert mem.blocked[18, 11] and not mem.blocked[18, 10]  # the pixel ahead; never the robot's own
+            assert mem.goal is None or not mem.blocked[mem.goal]
+        else:
+            assert not mem.blocked.any()
+            assert all(a[0] >= 0 for a in actions)

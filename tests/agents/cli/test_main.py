@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import json
 import shutil
 import subprocess
 import sys
@@ -79,6 +80,27 @@ def test_demo_at_reduced_length(tmp_path, capsys) -> None:  # type: ignore[no-un
     assert rc == 0 and (tmp_path / "episode.gif").stat().st_size > 0 and (tmp_path / "coverage.png").is_file()
     line = next(s for s in out.splitlines() if s.startswith("certified coverage"))
     assert 0.0 < float(line.split(":")[1].split()[0]) <= 1.0
+
+
+def test_the_demo_runs_the_best_agent_of_the_shipped_leaderboard_and_says_which(
+    tmp_path, capsys, monkeypatch
+) -> None:  # type: ignore[no-untyped-def]
+    """``--agent best`` (the demo's default) reads ``agents/data/leaderboard.json``; with a leaderboard that
+    names another agent it runs that one, and with none (or a damaged one) the frontier agent."""
+    best, why = models.best_agent()
+    assert best in cli.agent_names() and best != "best" and "leaderboard" in why
+    board = tmp_path / "board.json"
+    board.write_text(json.dumps(models.leaderboard_record("lawnmower", 812.0, 30, 3000, ["room", "rocks"])))
+    monkeypatch.setattr(models, "LEADERBOARD", board)
+    name, policy, kwargs = cli.resolve_agent("best", cli.DEFAULT_ENV, None)
+    assert name == "lawnmower" and kwargs == {} and type(policy).__name__ == "LawnmowerAgent"
+    assert (
+        "--agent best: lawnmower, best on the leaderboard (board.json: mean T90 812 steps"
+        in capsys.readouterr().out
+    )
+    board.write_text("{not json")
+    assert models.best_agent()[0] == "frontier"
+    assert cli.resolve_agent("best", cli.DEFAULT_ENV, None)[0] == "frontier"
 
 
 def test_demo_falls_back_to_frontier_without_the_shipped_model(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]

@@ -52,6 +52,10 @@ def test_first_candidate_goal_agent_is_the_frontier_agent(G: ModuleType, seed: i
     np.testing.assert_array_equal(np.array(env.actions), f_actions)
     np.testing.assert_array_equal(goal, frontier)
     assert 0 < agent.state().decisions < steps / 5  # macro steps, not single steps
+    st = agent.choice_stats()  # always candidate 0: never differs from the frontier agent, always a frontier
+    assert st["decisions"] == agent.state().decisions and st["not_first"] == 0.0 and st["frontier"] == 1.0
+    run_episode(agent, env, seed + 1, 50)  # a second episode adds to the counts (reset keeps them)
+    assert agent.choice_stats()["decisions"] > st["decisions"]
     # and the goal env driven by the same chooser
     base = _room(steps)
     genv = G.GoalSelectionEnv(base, max_steps=steps)
