@@ -14,6 +14,7 @@ from .frontier import (
     LawnmowerAgent,
     NavigatingAgent,
     UncertaintyAwareFrontier,
+    keep_bound,
 )
 from .planning import (
     SQUARE,
@@ -40,6 +41,7 @@ from .registry import (
 __all__ = [
     "KEEP_FACTOR",
     "KEEP_SLACK",
+    "keep_bound",
     "BASELINES",
     "BaselinePolicy",
     "FrontierAgent",

@@ -13,7 +13,8 @@ is left (its ``cautious`` pass), the soft one takes it when it is the shorter wa
 either way.
 
 * frontier candidates: traversable pixels next to dark ground (within the penumbra band that the tube
-  width adds), then next to penumbra, then any pixel not yet visited, each tier with a path-length penalty;
+  width adds), then next to penumbra, then any pixel not yet visited, each tier with a path-length penalty,
+  less a bonus for the dark ground around the pixel (the expected gain, ``gain_weight``);
   a pixel within ``visit_radius`` m of the robot's past positions is no longer a candidate (if it is still
   next to dark ground once the robot was there, it borders an obstacle, not the unexplored);
 * loop closure (:class:`UncertaintyAwareFrontier`): pixels next to sensed obstacles (penumbra) that the
@@ -40,13 +41,26 @@ import math
 from typing import Any
 
 import numpy as np
+from scipy import ndimage
 
 from digslam.agents.baselines import planning as pl
 from digslam.agents.baselines.policy import BaselinePolicy, Memory, View
 
-#: Hysteresis of the goal choice: the current goal is kept while its cost is at most
-#: ``KEEP_FACTOR * best + KEEP_SLACK`` pixels (``best``: the cheapest candidate's cost).
-KEEP_FACTOR, KEEP_SLACK = 1.2, 3.0
+#: Hysteresis of the goal choice: the current goal is kept while its cost is at most :func:`keep_bound`
+#: of the cheapest candidate's cost ``best``: ``KEEP_FACTOR * best + KEEP_SLACK`` pixels when ``best >= 0``.
+#: With the gain term (``FrontierAgent.gain_weight``), 1.0 (keep within 3 px of the best) matched or beat
+#: 1.2 on the validation levels (24 per generator: mean T90 1603 against 1634 steps, 0.9 reached on 73 %
+#: against 69 % of them).
+KEEP_FACTOR, KEEP_SLACK = 1.0, 3.0
+
+
+def keep_bound(best: float) -> float:
+    """The largest cost at which the current goal is kept: ``best + (KEEP_FACTOR - 1) |best| + KEEP_SLACK``
+    (``KEEP_FACTOR * best + KEEP_SLACK`` for ``best >= 0``; the gain term of ``FrontierAgent`` can make costs
+    negative, and the tolerance still grows with their size)."""
+    return best + (KEEP_FACTOR - 1.0) * abs(best) + KEEP_SLACK
+
+
 #: Stall detection (:meth:`NavigatingAgent._stalled`): over ``STALL_STEPS`` driving steps the robot covered
 #: less than ``STALL_SHARE`` of the commanded distance; it then backs off for ``BACK_STEPS`` steps.
 STALL_STEPS, STALL_SHARE, BACK_STEPS = 8, 0.25, 3
@@ -213,7 +227,7 @@ class NavigatingAgent(BaselinePolicy):
             mem.goal = mem.waypoint = None
             return
         g = mem.goal
-        if g is None or not (math.isfinite(cost[g]) and cost[g] <= KEEP_FACTOR * best + KEEP_SLACK):
+        if g is None or not (math.isfinite(cost[g]) and cost[g] <= keep_bound(best)):
             mem.goal = (k // cost.shape[1], k % cost.shape[1])
             mem.goal_steps = 0
             steps_per_px = self.px(view.clear.shape[0]) / (self.max_speed * self.dt)
@@ -250,6 +264,13 @@ class FrontierAgent(NavigatingAgent):
         turn_weight: Weight of the time to turn in place towards a goal, counted as the distance that
             could be driven meanwhile (a half turn takes as long as 3 m of driving at full scale); 4 was
             the best of 0-8 on the maps of seeds 0-2, taking about a fifth fewer steps to 0.8 than 0.
+        gain_weight: Weight (m) of the expected gain: a candidate's cost is lowered by ``gain_weight`` times
+            the dark share of the square of side twice the sensor range around it (the unexplored it may
+            open up), so that of two frontiers about as far the one facing more dark ground wins. 40 was
+            the best of 0-160 on the validation levels (seeds 1 000 000-1 000 023 of every generator, 3000
+            steps): mean T90 1603 against 1807 steps for the former defaults (0, and ``KEEP_FACTOR`` 1.2),
+            0.9 reached on 73 % of them against 62 % (the room: T90 472 against 909; the rocks: 96 %
+            against 58 %).
         penumbra_frontier: When no clear pixel is a candidate, take the reachable penumbra pixels next to
             dark ground not yet visited, those farther from clear ground than the tube's band along walls
             first (at the ``unvisited_penalty``): a corridor that the cones saw only in penumbra is otherwise
@@ -266,9 +287,13 @@ class FrontierAgent(NavigatingAgent):
         unvisited_penalty: float = 12.0,
         turn_weight: float = 4.0,
         penumbra_frontier: bool = True,
+        gain_weight: float = 40.0,
         **kw: Any,
     ) -> None:
         self.penumbra_frontier = bool(penumbra_frontier)
+        if not (math.isfinite(gain_weight) and gain_weight >= 0):
+            raise ValueError(f"gain_weight: must be finite and >= 0, got {gain_weight!r}")
+        self.gain_weight = float(gain_weight)
         named = (("penumbra_penalty", penumbra_penalty), ("unvisited_penalty", unvisited_penalty),
                  ("turn_weight", turn_weight))  # fmt: skip
         for name, v in named:
@@ -304,6 +329,10 @@ class FrontierAgent(NavigatingAgent):
                 np.angle(np.exp(1j * (np.arctan2(view.pos[0] - rr, cc - view.pos[1]) - view.heading)))
             )
             cost += self.turn_weight * err / self._turn * (self.max_speed * self.dt) / px
+        if self.gain_weight > 0:  # the expected gain: the dark share of the square of the sensor range
+            k = 2 * int(round(self.sensor_range / px)) + 1
+            gain = ndimage.uniform_filter(view.dark.astype(np.float64), size=k, mode="constant")
+            cost -= self.gain_weight * gain / px
         return cost
 
     def _costs(self, view: View, mem: Memory, reach: np.ndarray, dist: np.ndarray) -> np.ndarray:
@@ -480,6 +509,7 @@ class UncertaintyAwareFrontier(FrontierAgent):
 __all__ = [
     "KEEP_FACTOR",
     "KEEP_SLACK",
+    "keep_bound",
     "FrontierAgent",
     "LawnmowerAgent",
     "NavigatingAgent",

@@ -99,7 +99,7 @@ def tiers(driver: GoalDriver, view: View, mem: Memory, reach: np.ndarray) -> np.
     """``(m, m)`` frontier tier per pixel: 1 next to dark ground, 2 next to penumbra only, 3 merely unvisited,
     0 not a candidate; read from ``frontier_costs`` itself with no path length and no turn term."""
     flat = copy.copy(driver)
-    flat.turn_weight = 0.0
+    flat.turn_weight = flat.gain_weight = 0.0
     pen = flat.frontier_costs(view, mem, reach, np.zeros(reach.shape))
     px = driver.px(reach.shape[0])
     out = np.zeros(reach.shape, np.int8)

@@ -35,6 +35,7 @@ from digslam.agents.baselines.frontier import (
     KEEP_SLACK,
     NavigatingAgent,
     UncertaintyAwareFrontier,
+    keep_bound,
 )
 from digslam.agents.baselines.policy import Memory, View
 
@@ -63,7 +64,7 @@ def regret(cost: np.ndarray, goal: tuple[int, int]) -> float:
     """How much worse ``goal`` is than the frontier agent tolerates (> 0: it would switch; ``inf`` when
     ``goal`` is no frontier candidate)."""
     c = float(cost[goal])
-    return c - KEEP_FACTOR * float(cost.min()) - KEEP_SLACK if math.isfinite(c) else math.inf
+    return c - keep_bound(float(cost.min())) if math.isfinite(c) else math.inf
 
 
 class GoalDriver(UncertaintyAwareFrontier):

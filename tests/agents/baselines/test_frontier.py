@@ -157,3 +157,33 @@ def test_a_robot_driving_without_moving_blocks_the_pixel_ahead_and_backs_off() -
         else:
             assert not mem.blocked.any()
             assert all(a[0] >= 0 for a in actions)
+
+
+def test_of_two_frontiers_the_one_facing_more_dark_ground_wins() -> None:
+    """The expected gain (``gain_weight``): a clear strip with dark ground at both ends, the robot in the
+    middle facing neither end; beyond the west end a large dark area, beyond the east end, a pixel closer, a
+    thin dark band (then ground seen from elsewhere). Without the gain term the goal is the nearer east end;
+    with it, the west end."""
+    clear = np.zeros((36, 36), bool)
+    clear[16:20, 10:26] = True  # the strip
+    clear[:, 28:] = True  # already seen beyond the thin east band
+    dark = np.zeros_like(clear)
+    dark[:, :10] = True  # the large unexplored west
+    dark[:, 26:28] = True  # a thin dark band to the east
+    obs = _obs(clear, dark, (18.0, 18.0), tube=0.05)
+    obs["state"][4], obs["state"][5] = 0.0, 1.0  # heading north: both ends are a quarter turn away
+    goal = {}
+    for w in (0.0, 40.0):
+        agent = FrontierAgent(
+            BOX,
+            span=36.0,
+            visit_radius=0.5,
+            gain_weight=w,
+            sensor_range=12.0,
+            penumbra_penalty=100.0,
+            unvisited_penalty=200.0,
+        )  # dark-ground frontiers only
+        agent.predict(obs)
+        goal[w] = agent._mem[0].goal
+    assert goal[0.0] is not None and goal[0.0][1] >= 20  # the nearer east end
+    assert goal[40.0] is not None and goal[40.0][1] < 16  # the west end, facing the unexplored
