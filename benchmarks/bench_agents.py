@@ -18,7 +18,9 @@ frontier agent, one process>``; with a learned model it ends with ``speedup_t95=
 ``digslam train``, a goal-selection MaskablePPO model included.
 
 Usage: ``python benchmarks/bench_agents.py [--quick] [--maps 30] [--steps 3000] [--out DIR] [--model PATH]
-[--ray [--address A] [--workers N]]`` (also ``digslam benchmark agents ...``). The full suite (4 generators x
+[--set KEY=VALUE ...] [--generators G ...] [--ray [--address A] [--workers N]]`` (also ``digslam benchmark
+agents ...``). ``--set`` gives every agent and generator an environment keyword (``--set
+grid_cell=0.078125``: the observer on a grid twice as fine); ``--generators`` runs some generators only. The full suite (4 generators x
 30 maps x 3000 steps x 5 agents, about 1.8 M steps) takes roughly half an hour on one core (the frontier
 agent's 360 000 steps take about 135 s; the PPO policy is slower); ``--quick`` (3 maps,
 300 steps) a minute. ``--ray`` runs the same suite on a pool of Ray actors
@@ -40,7 +42,7 @@ import digslam.envs  # noqa: F401  (registers the environments)
 from digslam.agents.baselines.registry import BASELINES, make_baseline
 from digslam.agents.evaluation.metrics import paired_bootstrap_geomean
 from digslam.agents.evaluation.ray_eval import run_suite_ray
-from digslam.agents.evaluation.suite import run_suite, steps_per_second
+from digslam.agents.evaluation.suite import check_generators, run_suite, steps_per_second
 from digslam.agents.learning.models import leaderboard_record
 
 ENV_ID = "digslam/DigCoverage-v0"
@@ -53,6 +55,23 @@ def model_kwargs(model: Path) -> dict[str, Any]:
     from digslam.agents.learning.models import model_env_kwargs
 
     return model_env_kwargs(model)
+
+
+def env_settings(items: list[str]) -> dict[str, Any]:
+    """``--set KEY=VALUE`` items as environment keywords (values parsed as TOML literals, else strings).
+
+    Raises:
+        ValueError: an item without ``=``.
+    """
+    from digslam.agents.learning.train import parse_value
+
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, raw = item.partition("=")
+        if not sep or not key.strip():
+            raise ValueError(f"--set: expected KEY=VALUE, got {item!r}")
+        out[key.strip()] = parse_value(raw.strip())
+    return out
 
 
 def load_ppo(model: Path) -> Any:
@@ -85,26 +104,42 @@ def main() -> None:
     ap.add_argument("--ray", action="store_true", help="run the suite on Ray actors (identical results)")
     ap.add_argument("--address", default=None, help="with --ray: Ray cluster to attach to (default: local)")
     ap.add_argument("--workers", type=int, default=None, help="with --ray: actors (default: one per CPU)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="an environment keyword for every agent and generator, e.g. grid_cell=0.078125 "
+                         "(repeatable; values parsed as TOML literals)")  # fmt: skip
+    ap.add_argument("--generators", nargs="+", default=None, metavar="G",
+                    help="run these generators only (default: room rocks caves rooms)")  # fmt: skip
     args = ap.parse_args()
     if (args.address is not None or args.workers is not None) and not args.ray:
         ap.error("--address/--workers: only with --ray")
+    try:
+        common = env_settings(args.set)
+        gym.make(ENV_ID, **common).close()  # an unknown key or a bad value: one line, before any episode
+        check_generators(args.generators)
+    except ValueError as exc:
+        ap.error(str(exc).splitlines()[0])
     maps, steps = (3, 300) if args.quick else (args.maps, args.steps)
-    env = gym.make(ENV_ID)
+    env = gym.make(ENV_ID, **common)
     names = list(BASELINES) if not args.ray else ["frontier"]  # with --ray, only eval_steps_per_s runs here
     policies: dict[str, Any] = {name: make_baseline(name, env, seed=0) for name in names}
     env.close()
-    extra = {}
+    extra = {name: dict(common) for name in names}
     ppo = load_ppo(args.model)
     if ppo is not None:
-        policies["ppo"], extra["ppo"] = ppo, model_kwargs(args.model)
+        policies["ppo"], extra["ppo"] = ppo, {**model_kwargs(args.model), **common}
         print(f"PPO env keywords: {extra['ppo']}")
+    if common:
+        print(f"environment keywords of every agent: {common}")
     t0 = time.perf_counter()
     if args.ray:  # the same policies as specs: baselines sized from ENV_ID with seed 0, the PPO .zip
         specs = {name: name for name in BASELINES} | ({"ppo": str(args.model)} if ppo is not None else {})
-        res = run_suite_ray(specs, n_maps=maps, steps=steps, agent_env_kwargs=extra, address=args.address,
-                            workers=args.workers, policy_env=ENV_ID, policy_seed=0, progress=True)  # fmt: skip
+        extra = {name: dict(common) for name in BASELINES} | extra
+        res = run_suite_ray(specs, n_maps=maps, steps=steps, generators=args.generators, agent_env_kwargs=extra,
+                            address=args.address, workers=args.workers, policy_env=ENV_ID, policy_seed=0,
+                            progress=True)  # fmt: skip
     else:
-        res = run_suite(policies, n_maps=maps, steps=steps, agent_env_kwargs=extra, progress=True)
+        res = run_suite(policies, n_maps=maps, steps=steps, generators=args.generators, agent_env_kwargs=extra,
+                        progress=True)  # fmt: skip
     wall = time.perf_counter() - t0
     print(f"{len(res.results)} generators x {maps} test maps (seeds {res.seeds[0]}..{res.seeds[-1]}), "
           f"{steps} steps, target 1.0; {wall:.0f} s")  # fmt: skip
@@ -121,7 +156,7 @@ def main() -> None:
     )  # the shipped copy: models.LEADERBOARD
     print(f"wrote {args.out / 'best.json'} (best agent overall: {best})")
     best = res.best(list(BASELINES))
-    rate = steps_per_second(policies["frontier"], ENV_ID, steps=min(2000, 10 * steps))
+    rate = steps_per_second(policies["frontier"], ENV_ID, steps=min(2000, 10 * steps), env_kwargs=common)
     print(f"best_baseline={best}")
     print(f"heuristic_t90_success={res.success(best):.4f}")
     print(f"eval_steps_per_s={rate:.0f}")

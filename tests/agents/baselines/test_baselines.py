@@ -179,6 +179,8 @@ def test_bad_input() -> None:
         FrontierAgent(BOX, speed=2.0)
     with pytest.raises(ValueError, match="margin"):
         FrontierAgent(BOX, margin=-1)
+    with pytest.raises(ValueError, match="gain_weight"):
+        FrontierAgent(BOX, gain_weight=float("inf"))
     with pytest.raises(ValueError, match="tube_high"):
         UncertaintyAwareFrontier(BOX, tube_high=0.0)
     with pytest.raises(ValueError, match="lane_spacing"):
