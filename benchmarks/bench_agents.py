@@ -20,8 +20,9 @@ frontier agent, one process>``; with a learned model it ends with ``speedup_t95=
 Usage: ``python benchmarks/bench_agents.py [--quick] [--maps 30] [--steps 3000] [--out DIR] [--model PATH]
 [--set KEY=VALUE ...] [--generators G ...] [--ray [--address A] [--workers N]]`` (also ``digslam benchmark
 agents ...``). ``--set`` gives every agent and generator an environment keyword (``--set
-grid_cell=0.078125``: the observer on a grid twice as fine); ``--generators`` runs some generators only. The full suite (4 generators x
-30 maps x 3000 steps x 5 agents, about 1.8 M steps) takes roughly half an hour on one core (the frontier
+grid_cell=0.078125``: the observer on a grid twice as fine); ``--generators`` runs some generators only.
+The full suite (4 generators x 30 maps x 3000 steps x 5 agents, about 1.8 M steps) takes roughly half an
+hour on one core (the frontier
 agent's 360 000 steps take about 135 s; the PPO policy is slower); ``--quick`` (3 maps,
 300 steps) a minute. ``--ray`` runs the same suite on a pool of Ray actors
 (:func:`digslam.agents.evaluation.ray_eval.run_suite_ray`; a local instance with ``--workers`` CPUs, or the
@@ -151,17 +152,16 @@ def main() -> None:
           f"{res.to_json(args.out / 'suite.json')}")  # fmt: skip
     best = res.best(list(BASELINES) + (["ppo"] if "ppo" in res.agents else []))
     record = leaderboard_record(best, float(res.t90()[best].mean()), maps, steps, list(res.results))
-    (args.out / "best.json").write_text(
-        json.dumps(record, indent=2) + "\n"
-    )  # the shipped copy: models.LEADERBOARD
+    text = json.dumps(record, indent=2) + "\n"
+    (args.out / "best.json").write_text(text)  # shipped as agents/data/leaderboard.json (models.LEADERBOARD)
     print(f"wrote {args.out / 'best.json'} (best agent overall: {best})")
     best = res.best(list(BASELINES))
     rate = steps_per_second(policies["frontier"], ENV_ID, steps=min(2000, 10 * steps), env_kwargs=common)
     print(f"best_baseline={best}")
     print(f"heuristic_t90_success={res.success(best):.4f}")
     print(f"eval_steps_per_s={rate:.0f}")
-    if ppo is not None and callable(getattr(ppo, "choice_stats", None)):  # a goal-level model: its choices
-        st = ppo.choice_stats()
+    st = ppo.choice_stats() if callable(getattr(ppo, "choice_stats", None)) else {}  # a goal-level model
+    if st.get("decisions"):  # its choices (in this process: none with --ray)
         print(f"learned_choices: {st['decisions']:.0f} decisions, {100 * st['not_first']:.1f} % differ from the "
               f"frontier agent's pick; frontier {100 * st['frontier']:.1f} %, loop closure "
               f"{100 * st['closure']:.1f} %, turn in place {100 * st['turn']:.1f} %")  # fmt: skip

@@ -178,9 +178,7 @@ class GoalDriver(UncertaintyAwareFrontier):
         elif kind == TURN:
             if x["watch"] and np.isfinite(cost).any():
                 x["event"] = "frontier"
-        elif not (
-            reach[g] or kind == FRONTIER and math.isfinite(cost[g])
-        ):  # a penumbra frontier is reachable
+        elif not (reach[g] or (kind == FRONTIER and math.isfinite(cost[g]))):  # penumbra frontiers too
             x["event"] = "unreachable"
         elif kind == FRONTIER and mem.visited[g]:
             x["event"] = "reached"

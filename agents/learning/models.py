@@ -34,7 +34,8 @@ DATA = Path(__file__).parents[1] / "data"
 #: The shipped policy; the environment keywords it was trained with are in ``<model>.json``.
 PRETRAINED = DATA / "ppo_digcoverage.zip"
 #: The best agent of the last full leaderboard run (``benchmarks/bench_agents.py`` writes ``best.json`` to
-#: its ``--out``; the shipped copy lives here): ``digslam demo``'s default agent (:func:`best_agent`).
+#: its ``--out``; the shipped copy lives here): ``digslam demo``'s default agent (:func:`best_agent`). Its
+#: ``ppo`` means :data:`PRETRAINED`: ship a leaderboard won by a learned model together with that model.
 LEADERBOARD = DATA / "leaderboard.json"
 #: The environment the shipped policy was trained on (the default of every command that runs an agent).
 DEFAULT_ENV = "digslam/DigCoverage-v0"
