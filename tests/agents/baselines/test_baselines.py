@@ -8,6 +8,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from gymnasium import spaces
+from planner_obs import planner_obs
 
 import digslam.envs
 from digslam.agents.baselines import planning as pl
@@ -22,21 +23,6 @@ from digslam.agents.baselines.registry import (
 )
 
 BOX = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
-
-
-def _obs(clear: np.ndarray, pos: tuple[float, float], heading: float = 0.0, tube: float = 0.0,
-         elapsed: float = 0.1, dark: np.ndarray | None = None) -> dict[str, np.ndarray]:  # fmt: skip
-    """An observation with the given clear mask (rest dark or penumbra) and the robot at pixel ``pos``."""
-    m = clear.shape[0]
-    dark = ~clear if dark is None else dark
-    img = np.zeros((4, m, m), np.uint8)
-    img[0][clear], img[2][dark & ~clear], img[1][~clear & ~dark] = 255, 255, 255
-    ux, uy = 2 * pos[1] / m - 1, 1 - 2 * pos[0] / m
-    s = np.zeros(11, np.float32)
-    s[:4] = ux, uy, ux, uy
-    s[4:6] = math.cos(heading), math.sin(heading)
-    s[7], s[8], s[10] = math.tanh(tube), elapsed, 1.0
-    return {"map": img, "state": s}
 
 
 # --- planner -----------------------------------------------------------------------------------------------
@@ -99,7 +85,7 @@ def test_turn_then_go_turns_in_place_then_drives_straight() -> None:
 # --- observation parsing and predict ----------------------------------------------------------------------
 def test_parse_reads_the_world_frame_with_row_zero_at_the_top() -> None:
     clear = np.zeros((36, 36), bool)
-    obs = _obs(clear, (6.5, 30.5), heading=math.pi / 2, tube=0.3)
+    obs = planner_obs(clear, (6.5, 30.5), heading=math.pi / 2, tube=0.3)
     v = parse(obs["map"], obs["state"])
     assert v.pos == pytest.approx([6.5, 30.5], abs=1e-5) and v.cell == (6, 30)
     assert v.heading == pytest.approx(math.pi / 2) and v.tube == pytest.approx(0.3, abs=1e-6)
@@ -112,7 +98,7 @@ def test_frontier_goes_to_the_nearest_frontier_through_the_door() -> None:
     clear[24:28, 17:19] = True  # a door between two clear halves
     dark = np.zeros_like(clear)
     dark[4:32, 32:] = True  # unexplored ground only on the right
-    obs = _obs(clear, (10.5, 8.5), heading=0.0, dark=dark)
+    obs = planner_obs(clear, (10.5, 8.5), heading=0.0, dark=dark)
     # the wall is penumbra here: crossing it (2 pixels at 50 each) costs more than the detour by the door
     agent = FrontierAgent(
         BOX,
@@ -132,7 +118,7 @@ def test_frontier_goes_to_the_nearest_frontier_through_the_door() -> None:
 def test_predict_batched_and_resets_per_environment() -> None:
     clear = np.zeros((36, 36), bool)
     clear[8:28, 8:28] = True
-    o1, o2 = _obs(clear, (18.0, 18.0)), _obs(clear, (12.0, 12.0), heading=1.0)
+    o1, o2 = planner_obs(clear, (18.0, 18.0)), planner_obs(clear, (12.0, 12.0), heading=1.0)
     batch = {k: np.stack([o1[k], o2[k]]) for k in o1}
     for name, cls in BASELINES.items():
         agent = cls(BOX, seed=0)
@@ -158,14 +144,16 @@ def test_uncertainty_aware_frontier_returns_to_obstacles_seen_with_a_narrow_tube
     dark = np.zeros_like(clear)
     dark[:, 34:] = True
     agent = UncertaintyAwareFrontier(BOX, tube_high=0.5, span=36.0)
-    agent.predict(_obs(clear, (4.5, 4.5), tube=0.05, dark=dark))  # near the top-left walls, narrow tube
+    agent.predict(
+        planner_obs(clear, (4.5, 4.5), tube=0.05, dark=dark)
+    )  # near the top-left walls, narrow tube
     assert agent._mem[0].extra.get("closing") is None
-    agent.predict(_obs(clear, (20.5, 20.5), tube=0.8, dark=dark))  # far from them, wide tube
+    agent.predict(planner_obs(clear, (20.5, 20.5), tube=0.8, dark=dark))  # far from them, wide tube
     mem = agent._mem[0]
     assert mem.extra["closing"] == pytest.approx(0.8, abs=1e-6) and mem.goal is not None
     assert mem.goal[0] < 8 and mem.goal[1] < 8  # back to the well-mapped corner, not to the frontier
     for _ in range(3):
-        agent.predict(_obs(clear, (20.5, 20.5), tube=0.4, dark=dark))
+        agent.predict(planner_obs(clear, (20.5, 20.5), tube=0.4, dark=dark))
     assert mem.extra["closing"] is None  # the tube shrank: exploring again
 
 
@@ -262,7 +250,7 @@ def test_soft_planner_takes_a_corridor_narrower_than_the_erosion() -> None:
     clear[17:19, 15:21] = True  # the corridor
     dark = np.zeros_like(clear)
     dark[:, 33:] = True  # unexplored beyond the second room; the rest is penumbra
-    obs = _obs(clear, (18.0, 8.5), heading=0.0, dark=dark)
+    obs = planner_obs(clear, (18.0, 8.5), heading=0.0, dark=dark)
     goals = {}
     for soft in (True, False):
         agent = FrontierAgent(

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import math
-
 import gymnasium as gym
 import numpy as np
 import pytest
 from gymnasium import spaces
+from planner_obs import planner_obs
 
 import digslam.envs  # noqa: F401  (registers the env ids)
 from digslam.agents.baselines.frontier import BACK_STEPS, STALL_STEPS, FrontierAgent
@@ -15,18 +14,6 @@ from digslam.agents.baselines.registry import BASELINES, UncertaintyAwareFrontie
 from digslam.envs.sim.generators import GENERATORS
 
 BOX = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
-
-
-def _obs(clear: np.ndarray, dark: np.ndarray, pos: tuple[float, float], tube: float) -> dict[str, np.ndarray]:
-    """An observation with the clear and dark masks (the rest penumbra), the robot at pixel ``pos``."""
-    m = clear.shape[0]
-    img = np.zeros((4, m, m), np.uint8)
-    img[0][clear], img[2][dark & ~clear], img[1][~clear & ~dark] = 255, 255, 255
-    ux, uy = 2 * pos[1] / m - 1, 1 - 2 * pos[0] / m
-    s = np.zeros(11, np.float32)
-    s[:4] = ux, uy, ux, uy
-    s[4], s[7], s[8], s[10] = 1.0, math.tanh(tube), 0.1, 1.0
-    return {"map": img, "state": s}
 
 
 def test_a_closure_with_no_target_left_ends_at_once_even_through_the_cautious_pass() -> None:
@@ -38,13 +25,13 @@ def test_a_closure_with_no_target_left_ends_at_once_even_through_the_cautious_pa
     pen[2:34, 2:34] = True
     dark = ~pen  # sensed obstacles (penumbra) all around the clear room, dark beyond
     agent = UncertaintyAwareFrontier(BOX, tube_high=0.5, span=36.0)
-    agent.predict(_obs(clear, dark, (18.5, 18.5), tube=0.05))
+    agent.predict(planner_obs(clear, (18.5, 18.5), dark, tube=0.05))
     mem = agent._mem[0]
     mem.visited[:] = True  # nothing left to explore over clear ground: the cautious pass runs
     mem.extra.update(closing=0.8, t0=mem.t, done_at=[np.array([18.5, 18.5])], high=0.5, closures=1)
     mem.best_tube[:] = np.inf  # no obstacle was passed with a narrow tube: no loop-closure target anywhere
     mem.goal = mem.waypoint = None
-    action, _ = agent.predict(_obs(clear, dark, (18.5, 18.5), tube=0.8))
+    action, _ = agent.predict(planner_obs(clear, (18.5, 18.5), dark, tube=0.8))
     assert BOX.contains(action)
     assert mem.extra["closing"] is None  # the closure ended: it had nowhere to go
     assert mem.extra["high"] == pytest.approx(0.8 * agent.backoff)  # a failed one: the tube did not shrink
@@ -57,17 +44,19 @@ def test_a_closure_keeps_going_while_targets_remain() -> None:
     dark = np.zeros_like(clear)
     dark[:, 34:] = True
     agent = UncertaintyAwareFrontier(BOX, tube_high=0.5, span=36.0, visits=3)
-    agent.predict(_obs(clear, dark, (4.5, 4.5), tube=0.05))  # near the top-left walls, narrow tube
-    agent.predict(_obs(clear, dark, (4.5, 29.5), tube=0.05))  # near the top-right ones, 25 m away
-    agent.predict(_obs(clear, dark, (20.5, 20.5), tube=0.8))
+    agent.predict(planner_obs(clear, (4.5, 4.5), dark, tube=0.05))  # near the top-left walls, narrow tube
+    agent.predict(planner_obs(clear, (4.5, 29.5), dark, tube=0.05))  # near the top-right ones, 25 m away
+    agent.predict(planner_obs(clear, (20.5, 20.5), dark, tube=0.8))
     mem = agent._mem[0]
     assert mem.extra["closing"] == pytest.approx(0.8, abs=1e-6) and mem.extra["targets"]
     first = mem.goal
-    agent.predict(_obs(clear, dark, (first[0] + 0.5, first[1] + 0.5), tube=0.8))  # at the target: one visit
+    agent.predict(
+        planner_obs(clear, (first[0] + 0.5, first[1] + 0.5), dark, tube=0.8)
+    )  # at the target: one visit
     assert len(mem.extra["done_at"]) == 1 and mem.extra["closing"] is not None  # the other corner is left
     assert mem.goal is not None and abs(mem.goal[1] - first[1]) > 15
     second = mem.goal
-    agent.predict(_obs(clear, dark, (second[0] + 0.5, second[1] + 0.5), tube=0.8))
+    agent.predict(planner_obs(clear, (second[0] + 0.5, second[1] + 0.5), dark, tube=0.8))
     assert len(mem.extra["done_at"]) == 2 and mem.extra["closing"] is None  # no target left: it ended
     assert mem.extra["high"] == pytest.approx(0.8 * agent.backoff)
 
@@ -121,11 +110,11 @@ def test_with_every_clear_pixel_visited_the_goal_is_the_far_end_of_a_penumbra_co
     goals = {}
     for on in (True, False):
         agent = FrontierAgent(BOX, span=36.0, penumbra_frontier=on)
-        agent.predict(_obs(clear, dark, (18.5, 9.5), tube=0.05))
+        agent.predict(planner_obs(clear, (18.5, 9.5), dark, tube=0.05))
         mem = agent._mem[0]
         mem.visited[clear] = True  # the whole room explored
         mem.goal = mem.waypoint = None
-        agent.predict(_obs(clear, dark, (18.5, 9.5), tube=0.05))
+        agent.predict(planner_obs(clear, (18.5, 9.5), dark, tube=0.05))
         goals[on] = mem.goal
     assert goals[False] is None
     g = goals[True]
@@ -140,7 +129,9 @@ def test_a_robot_driving_without_moving_blocks_the_pixel_ahead_and_backs_off() -
     clear[4:32, 4:32] = True
     dark = np.zeros_like(clear)
     dark[:, 33:] = True
-    obs = _obs(clear, dark, (18.5, 10.5), tube=0.05)  # heading +x (state[4] = cos = 1), frontier to the east
+    obs = planner_obs(
+        clear, (18.5, 10.5), dark, tube=0.05
+    )  # heading +x (state[4] = cos = 1), frontier to the east
     for unstick in (True, False):
         agent = FrontierAgent(BOX, span=36.0, visit_radius=0.5, unstick=unstick)
         actions = [agent.predict(obs)[0] for _ in range(STALL_STEPS + 1 + BACK_STEPS)]
@@ -170,7 +161,7 @@ def test_of_two_frontiers_the_one_facing_more_dark_ground_wins() -> None:
     dark = np.zeros_like(clear)
     dark[:, :10] = True  # the large unexplored west
     dark[:, 26:28] = True  # a thin dark band to the east
-    obs = _obs(clear, dark, (18.0, 18.0), tube=0.05)
+    obs = planner_obs(clear, (18.0, 18.0), dark, tube=0.05)
     obs["state"][4], obs["state"][5] = 0.0, 1.0  # heading north: both ends are a quarter turn away
     goal = {}
     for w in (0.0, 40.0):

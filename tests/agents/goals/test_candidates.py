@@ -14,6 +14,7 @@ from types import ModuleType
 import numpy as np
 import pytest
 from gymnasium import spaces
+from planner_obs import planner_obs
 
 from digslam.agents.baselines import planning as pl
 from digslam.agents.baselines.frontier import FrontierAgent
@@ -25,20 +26,6 @@ BOX = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
 @pytest.fixture(scope="module")
 def G() -> ModuleType:
     return importlib.import_module("digslam.agents.goals")
-
-
-def _obs(clear: np.ndarray, dark: np.ndarray, pos: tuple[float, float], heading: float = 0.0,
-         tube: float = 0.02) -> dict[str, np.ndarray]:  # fmt: skip
-    """An observation with the clear and dark masks (the rest penumbra), the robot at pixel ``pos``."""
-    m = clear.shape[0]
-    img = np.zeros((4, m, m), np.uint8)
-    img[0][clear], img[2][dark & ~clear], img[1][~clear & ~dark] = 255, 255, 255
-    ux, uy = 2 * pos[1] / m - 1, 1 - 2 * pos[0] / m
-    s = np.zeros(11, np.float32)
-    s[:4] = ux, uy, ux, uy
-    s[4:6] = math.cos(heading), math.sin(heading)
-    s[7], s[8], s[10] = math.tanh(tube), 0.1, 1.0
-    return {"map": img, "state": s}
 
 
 def _room() -> tuple[np.ndarray, np.ndarray]:
@@ -64,7 +51,7 @@ def test_clusters_keep_each_components_cheapest_pixel_sorted_by_cost(G: ModuleTy
 @pytest.mark.parametrize("heading", [0.0, math.pi])
 def test_candidate_zero_is_the_frontier_agents_goal(G: ModuleType, heading: float) -> None:
     clear, dark = _room()
-    obs = _obs(clear, dark, (18.5, 12.5), heading)
+    obs = planner_obs(clear, (18.5, 12.5), dark, heading, tube=0.02)
     kw = {"span": 36.0, "unvisited_penalty": 100.0}  # the dark-ground frontiers first
     agent = FrontierAgent(BOX, **kw)
     agent.predict(obs)
@@ -92,7 +79,7 @@ def test_candidate_zero_is_the_frontier_agents_goal(G: ModuleType, heading: floa
 
 def test_with_no_frontier_left_the_turn_comes_first(G: ModuleType) -> None:
     clear, dark = _room()
-    obs = _obs(clear, dark, (18.5, 12.5))
+    obs = planner_obs(clear, (18.5, 12.5), dark, tube=0.02)
     driver = G.GoalDriver(BOX, span=36.0)
     mem = driver.begin(36)
     mem.visited[:] = True
@@ -107,9 +94,9 @@ def test_loop_closure_candidates_are_pixels_passed_with_a_narrow_tube(G: ModuleT
     driver = G.GoalDriver(BOX, span=36.0)
     mem = driver.begin(36)
     for pos in [(9.5, 8.5), (9.5, 27.5)]:  # near the top-left and top-right walls, narrow tube
-        view = parse(*_obs(clear, dark, pos, tube=0.05).values())
+        view = parse(*planner_obs(clear, pos, dark, tube=0.05).values())
         G.candidates(driver, view, mem)
-    view = parse(*_obs(clear, dark, (20.5, 18.5), tube=0.8).values())
+    view = parse(*planner_obs(clear, (20.5, 18.5), dark, tube=0.8).values())
     c = G.candidates(driver, view, mem, n=16)
     closure = np.flatnonzero(c.kind == G.CLOSURE)
     assert closure.size >= 1 and closure.min() > np.flatnonzero(c.kind == G.TURN)[0]
@@ -118,7 +105,7 @@ def test_loop_closure_candidates_are_pixels_passed_with_a_narrow_tube(G: ModuleT
         near = pl.dilate(view.penumbra, driver.erosion(view) + 1)  # next to sensed obstacles
         assert mem.best_tube[tuple(c.goal[s])] <= 0.4 and near[tuple(c.goal[s])]
     # with the tube as narrow as then, nothing calls for a loop closure
-    view = parse(*_obs(clear, dark, (20.5, 18.5), tube=0.05).values())
+    view = parse(*planner_obs(clear, (20.5, 18.5), dark, tube=0.05).values())
     assert G.candidates(driver, view, mem, n=16).n_closure == 0
 
 
@@ -126,8 +113,8 @@ def test_few_slots_keep_the_cheapest_frontiers_the_turn_and_some_closures(G: Mod
     clear, dark = _room()
     driver = G.GoalDriver(BOX, span=36.0)
     mem = driver.begin(36)
-    G.candidates(driver, parse(*_obs(clear, dark, (9.5, 8.5), tube=0.05).values()), mem)
-    view = parse(*_obs(clear, dark, (20.5, 18.5), tube=0.8).values())
+    G.candidates(driver, parse(*planner_obs(clear, (9.5, 8.5), dark, tube=0.05).values()), mem)
+    view = parse(*planner_obs(clear, (20.5, 18.5), dark, tube=0.8).values())
     full = G.candidates(driver, view, mem, n=32)
     two = G.candidates(driver, view, mem, n=2)
     assert two.mask.all() and two.kind.tolist() == [G.FRONTIER, G.TURN]
