@@ -23,7 +23,7 @@ The envs move the robot with pymunk, the default dynamics (the record then bound
 and the filter's tube grows with it). The same pair (raw, observed at ``q = 0``) with the exact unicycle
 dynamics runs afterwards on the same actions and seeds; its figures end in ``_unicycle``.
 
-Usage: ``python benchmarks/bench_observer.py [--steps N] [--episode K] [--chunk C]``. Last line:
+Usage: ``python benchmarks/bench_observer.py [--steps N] [--episode K] [--chunk C] [--grid-cell S]`` (``S``: the observer's cell side, m; 0.078125 for the grid twice as fine). Last line:
 ``observer_overhead=<raw steps per second / observed steps per second>`` (``q = 0``).
 """
 
@@ -85,21 +85,27 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=2000)
     parser.add_argument("--episode", type=int, default=500)
     parser.add_argument("--chunk", type=int, default=100)
+    parser.add_argument(
+        "--grid-cell", type=float, default=None, help="observer cell side (m); default: the env's"
+    )
     args = parser.parse_args()
     rng = np.random.default_rng(0)
     actions = np.column_stack([rng.uniform(0.2, 1.0, args.steps), rng.uniform(-1, 1, args.steps)])
     actions = actions.astype(np.float32)
     steps = args.episode + 1
+    cell = {} if args.grid_cell is None else {"grid_cell": args.grid_cell}
     raw = gym.make("digslam/Explore-v0", max_episode_steps=steps)
-    obs = gym.make("digslam/DigCoverage-v0", max_episode_steps=steps, target=1.0)
-    obs1 = gym.make("digslam/DigCoverage-v0", max_episode_steps=steps, target=1.0, q=1)
+    obs = gym.make("digslam/DigCoverage-v0", max_episode_steps=steps, target=1.0, **cell)
+    obs1 = gym.make("digslam/DigCoverage-v0", max_episode_steps=steps, target=1.0, q=1, **cell)
     run_pair(raw, [obs, obs1], actions[:50], 50, 50, [[], []])  # warm-up
     probes: list[list[float]] = [[], []]
     t_raw, t_obs, t_obs1 = run_pair(raw, [obs, obs1], actions, args.episode, args.chunk, probes)
     up, up1 = np.array(probes[0]), np.array(probes[1])
     raw_sps, obs_sps, obs1_sps = args.steps / t_raw, args.steps / t_obs, args.steps / t_obs1
     raw_u = gym.make("digslam/Explore-v0", max_episode_steps=steps, dynamics="unicycle")
-    obs_u = gym.make("digslam/DigCoverage-v0", max_episode_steps=steps, target=1.0, dynamics="unicycle")
+    obs_u = gym.make(
+        "digslam/DigCoverage-v0", max_episode_steps=steps, target=1.0, dynamics="unicycle", **cell
+    )
     run_pair(raw_u, [obs_u], actions[:50], 50, 50, [[]])  # warm-up
     probe_u: list[list[float]] = [[]]
     t_raw_u, t_obs_u = run_pair(raw_u, [obs_u], actions, args.episode, args.chunk, probe_u)

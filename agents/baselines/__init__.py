@@ -1,10 +1,12 @@
 """Heuristic coverage agents: the baselines every learned policy is compared to.
 
 Lives here: :mod:`.registry` (``BASELINES``, ``make_baseline``), :mod:`.policy` (the policy interface,
-``RandomAgent``), :mod:`.planning` (grid path planning) and :mod:`.frontier` (frontier, uncertainty-aware
-frontier and lawnmower agents).
+``RandomAgent``), :mod:`.planning` (grid path planning), :mod:`.frontier` (frontier, uncertainty-aware
+frontier and lawnmower agents) and :mod:`.tour` (the tour frontier agent; its Held-Karp kernel beside it in
+:mod:`.tour_jit`).
 
-May import: :mod:`digslam.envs` (observations and spaces); numpy, scipy.
+May import: :mod:`digslam.envs` (observations and spaces), :mod:`digslam.observer.core.scalar_jit` (the
+project's ``njit``); numpy, scipy, numba.
 """
 
 from .frontier import (
@@ -21,7 +23,9 @@ from .planning import (
     dilate,
     erode,
     line_of_sight,
+    path_lengths,
     path_to,
+    pixel_graph,
     shortest_paths,
     turn_then_go,
     wrap,
@@ -37,6 +41,7 @@ from .registry import (
     BASELINES,
     make_baseline,
 )
+from .tour import TourFrontierAgent, tour_regret
 
 __all__ = [
     "KEEP_FACTOR",
@@ -50,6 +55,7 @@ __all__ = [
     "NavigatingAgent",
     "RandomAgent",
     "SQUARE",
+    "TourFrontierAgent",
     "UncertaintyAwareFrontier",
     "View",
     "dilate",
@@ -57,8 +63,11 @@ __all__ = [
     "line_of_sight",
     "make_baseline",
     "parse",
+    "path_lengths",
     "path_to",
+    "pixel_graph",
     "shortest_paths",
+    "tour_regret",
     "turn_then_go",
     "wrap",
 ]

@@ -303,13 +303,20 @@ class FrontierAgent(NavigatingAgent):
         self.turn_weight = turn_weight
         super().__init__(action_space, observation_space, seed, **kw)
 
-    def frontier_costs(self, view: View, mem: Memory, reach: np.ndarray, dist: np.ndarray) -> np.ndarray:
-        """Path length plus the tier penalty of every frontier pixel (``inf`` elsewhere)."""
+    def frontier_tiers(self, view: View, mem: Memory, reach: np.ndarray) -> tuple[np.ndarray, ...]:
+        """The candidate pixels by tier: ``(dark, pen, free)``, reachable unvisited pixels next to dark ground
+        (within the band the tube adds), those next to penumbra only, and all reachable unvisited ones."""
         px = self.px(view.clear.shape[0])
         band = self.erosion(view) + 1 + int(math.ceil(view.tube / px))
         free = reach & ~mem.visited
         dark = free & pl.dilate(view.dark, band + 1)
         pen = free & ~dark & pl.dilate(view.penumbra, self.erosion(view) + 1)
+        return dark, pen, free
+
+    def frontier_costs(self, view: View, mem: Memory, reach: np.ndarray, dist: np.ndarray) -> np.ndarray:
+        """Path length plus the tier penalty of every frontier pixel (``inf`` elsewhere)."""
+        px = self.px(view.clear.shape[0])
+        dark, pen, free = self.frontier_tiers(view, mem, reach)
         cost = np.full(dist.shape, np.inf)
         cost[free] = dist[free] + self.unvisited_penalty / px
         cost[pen] = dist[pen] + self.penumbra_penalty / px

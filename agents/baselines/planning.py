@@ -4,8 +4,8 @@ The agents read only the observation (``"map"`` channels clear / penumbra / dark
 top = largest ``y``; ``"state"`` with the pose box normalised to ``[-1, 1]`` over the grid frame). Planning
 runs on the ``m x m`` map in pixel coordinates ``(row, col)``:
 
-* :func:`shortest_paths`: Dijkstra over the 8-connected graph of traversable pixels (``scipy.sparse.csgraph``,
-  edges built with whole-array numpy, no per-cell Python loop);
+* :func:`shortest_paths`: Dijkstra over the 8-connected graph of traversable pixels (``scipy.sparse.csgraph``
+  over :func:`pixel_graph`); :func:`path_lengths` from several pixels at once;
 * :func:`path_to`: the pixel path from the predecessor array (a loop over the path's pixels, not the grid);
 * :func:`line_of_sight`: the farthest path pixel reachable in a straight line over traversable pixels
   (string pulling, vectorised over the path and its samples);
@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 from scipy import ndimage
-from scipy.sparse import coo_matrix
+from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 #: 8-neighbourhood offsets (dr, dc) and their lengths (pixels).
@@ -50,6 +50,35 @@ def shortest_paths(
     if not (0 <= r0 < h and 0 <= c0 < w):
         raise ValueError(f"start: {start} lies outside the {h} x {w} grid")
     free[r0, c0] = True
+    dist, pred = dijkstra(pixel_graph(free, weight), indices=r0 * w + c0, return_predecessors=True)
+    return dist.reshape(h, w), pred
+
+
+def path_lengths(free: np.ndarray, starts: np.ndarray, weight: np.ndarray | None = None) -> np.ndarray:
+    """``(S, h, w)`` path lengths from each of the ``(S, 2)`` pixels ``starts`` over the same graph as
+    :func:`shortest_paths` (one Dijkstra call for all of them; the starts are treated as free).
+
+    >>> free = np.ones((3, 4), dtype=bool); free[:2, 1] = False
+    >>> path_lengths(free, np.array([[0, 0], [0, 3]]))[:, 0, 3].round(3).tolist()   # around the wall, and 0
+    [6.414, 0.0]
+    """
+    free = np.asarray(free, dtype=bool).copy()
+    starts = np.asarray(starts, dtype=np.int64).reshape(-1, 2)
+    h, w = free.shape
+    if starts.size and not ((starts >= 0).all() and (starts[:, 0] < h).all() and (starts[:, 1] < w).all()):
+        raise ValueError(f"starts: a pixel lies outside the {h} x {w} grid")
+    free[starts[:, 0], starts[:, 1]] = True
+    if not len(starts):
+        return np.zeros((0, h, w))
+    dist = dijkstra(pixel_graph(free, weight), indices=starts[:, 0] * w + starts[:, 1])
+    return np.asarray(dist).reshape(len(starts), h, w)
+
+
+def pixel_graph(free: np.ndarray, weight: np.ndarray | None = None) -> csr_matrix:
+    """The 8-connected graph of the ``free`` pixels as a sparse matrix over the flat pixel indices (edges
+    built with whole-array numpy, no per-cell Python loop): a move costs its length (1 or √2), times the
+    mean of its two ends' ``weight`` when given; diagonal moves need both side pixels free."""
+    h, w = free.shape
     idx = np.arange(h * w).reshape(h, w)
     rows, cols, wts = [], [], []
     for dr, dc in _OFFSETS:  # four edge directions, each a whole-array operation
@@ -68,9 +97,7 @@ def shortest_paths(
             step = step * 0.5 * (weight.flat[ia] + weight.flat[ib])
         wts += [step, step]
     r, c = np.concatenate(rows), np.concatenate(cols)
-    graph = coo_matrix((np.concatenate(wts), (r, c)), shape=(h * w, h * w)).tocsr()
-    dist, pred = dijkstra(graph, indices=int(idx[r0, c0]), return_predecessors=True)
-    return dist.reshape(h, w), pred
+    return coo_matrix((np.concatenate(wts), (r, c)), shape=(h * w, h * w)).tocsr()
 
 
 def path_to(pred: np.ndarray, shape: tuple[int, int], goal: tuple[int, int]) -> np.ndarray:

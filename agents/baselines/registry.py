@@ -5,6 +5,8 @@
 * :class:`FrontierAgent`: nearest frontier between clear and dark (then penumbra) ground, Dijkstra over
   the clear pixels (:mod:`.planning`); it turns in place and drives straight, since the guaranteed
   observer's box grows about 17 times faster along arcs than along straight lines;
+* :class:`TourFrontierAgent`: the frontier agent whose goal starts the shortest open tour over the frontier
+  clusters (a regret term on the clusters that would leave a detour behind, :mod:`.tour`);
 * :class:`UncertaintyAwareFrontier`: when the tube is wider than a threshold, goes back into clear ground
   near sensed obstacles, visited while the tube was narrow, and turns there until the tube shrinks (active
   loop closure).
@@ -26,6 +28,7 @@ from typing import Any
 
 from digslam.agents.baselines.frontier import FrontierAgent, LawnmowerAgent, UncertaintyAwareFrontier
 from digslam.agents.baselines.policy import BaselinePolicy, RandomAgent
+from digslam.agents.baselines.tour import TourFrontierAgent
 
 #: Baseline names and classes.
 BASELINES: dict[str, type[BaselinePolicy]] = {
@@ -33,6 +36,7 @@ BASELINES: dict[str, type[BaselinePolicy]] = {
     "lawnmower": LawnmowerAgent,
     "frontier": FrontierAgent,
     "uncertainty_frontier": UncertaintyAwareFrontier,
+    "tour_frontier": TourFrontierAgent,
 }
 
 
@@ -73,6 +77,7 @@ __all__ = [
     "FrontierAgent",
     "LawnmowerAgent",
     "RandomAgent",
+    "TourFrontierAgent",
     "UncertaintyAwareFrontier",
     "make_baseline",
 ]

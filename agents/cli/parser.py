@@ -18,7 +18,7 @@ def agent_options(p: argparse.ArgumentParser, default: str) -> None:
     """Add ``--agent`` (default ``default``), ``--model``, ``--env`` and ``--seed`` to ``p``."""
     p.add_argument("--agent", default=default,
                    help="best (the best agent of the shipped leaderboard), ppo (the pretrained policy) or "
-                        "a baseline: random, lawnmower, frontier, uncertainty_frontier "
+                        "a baseline: random, lawnmower, frontier, uncertainty_frontier, tour_frontier "
                         "(default %(default)s)")  # fmt: skip
     p.add_argument("--model", default=None, help="saved PPO model (.zip) instead of the shipped one")
     p.add_argument("--env", default=DEFAULT_ENV, help="environment id (default %(default)s)")

@@ -62,7 +62,7 @@ BATCHES_PER_ACTOR = 4
 
 #: Baseline names accepted as specs (mirrors ``digslam.agents.baselines.registry.BASELINES``; checked in the
 #: worker).
-BASELINE_NAMES = ("random", "lawnmower", "frontier", "uncertainty_frontier")
+BASELINE_NAMES = ("random", "lawnmower", "frontier", "uncertainty_frontier", "tour_frontier")
 
 PolicySpec = str
 
