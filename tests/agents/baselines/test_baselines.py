@@ -229,6 +229,8 @@ def test_frontier_proves_more_than_random_and_keeps_the_tube_narrow(dynamics: st
         "baselines.policy",
         "baselines.frontier",
         "baselines.registry",
+        "baselines.tour",
+        "baselines.tour_jit",
         "evaluation.evaluate",
     ],
 )
