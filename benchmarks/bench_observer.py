@@ -23,7 +23,8 @@ The envs move the robot with pymunk, the default dynamics (the record then bound
 and the filter's tube grows with it). The same pair (raw, observed at ``q = 0``) with the exact unicycle
 dynamics runs afterwards on the same actions and seeds; its figures end in ``_unicycle``.
 
-Usage: ``python benchmarks/bench_observer.py [--steps N] [--episode K] [--chunk C] [--grid-cell S]`` (``S``: the observer's cell side, m; 0.078125 for the grid twice as fine). Last line:
+Usage: ``python benchmarks/bench_observer.py [--steps N] [--episode K] [--chunk C] [--grid-cell S]``
+(``S``: the observer's cell side, m; 0.078125 for the grid twice as fine). Last line:
 ``observer_overhead=<raw steps per second / observed steps per second>`` (``q = 0``).
 """
 
