@@ -31,8 +31,8 @@ The tour pays where frontiers are few and far apart (the rooms' corridors: the l
 for the end) and costs where they are many and small (the gaps between rocks: ordering a dozen small
 clusters delays the last few per cent). ``tour_weight`` 1 gave rooms T80 2463 (AUC 0.322); ``min_cluster``
 6 was worse on rooms and rocks, and so was one stop for all clusters within the sensor range (5 m) of each
-other (rooms T80 2555, rocks 0.9 on 58 %). So it is a comparison row of the leaderboard, not the frontier agent's
-replacement.
+other (rooms T80 2555, rocks 0.9 on 58 %). So it is a comparison row of the leaderboard, not the frontier
+agent's replacement.
 
 >>> from gymnasium import spaces
 >>> agent = TourFrontierAgent(spaces.Box(-1, 1, (2,)))
