@@ -18,9 +18,13 @@ frontier agent, one process>``; with a learned model it ends with ``speedup_t95=
 ``digslam train``, a goal-selection MaskablePPO model included.
 
 Usage: ``python benchmarks/bench_agents.py [--quick] [--maps 30] [--steps 3000] [--out DIR] [--model PATH]
-[--set KEY=VALUE ...] [--generators G ...] [--ray [--address A] [--workers N]]`` (also ``digslam benchmark
-agents ...``). ``--set`` gives every agent and generator an environment keyword (``--set
-grid_cell=0.078125``: the observer on a grid twice as fine); ``--generators`` runs some generators only.
+[--set KEY=VALUE ...] [--generators G ...] [--agents A ...] [--ray [--address A] [--workers N]]`` (also
+``digslam benchmark agents ...``). ``--set`` gives every agent and generator an environment keyword (``--set
+grid_cell=0.078125``: the observer on a grid twice as fine; ``--set 'noise={speed=0.0, yaw_rate=0.0}'``:
+exact odometry, the certified ceiling of a planner when the pose box does not drift); ``--generators`` runs
+some generators only; ``--agents`` some agents only (``--agents frontier``: the reference baseline alone,
+about 150 s for the full suite; the best baseline and ``heuristic_t90_success`` are then those of the agents
+run).
 The full suite (4 generators x 30 maps x 3000 steps x 5 agents, about 1.8 M steps) takes roughly half an
 hour on one core (the frontier
 agent's 360 000 steps take about 135 s; the PPO policy is slower); ``--quick`` (3 maps,
@@ -75,6 +79,21 @@ def env_settings(items: list[str]) -> dict[str, Any]:
     return out
 
 
+def chosen_baselines(agents: list[str] | None) -> list[str]:
+    """The baselines that ``--agents`` names (all of them for None), in the registry's order, the frontier
+    agent always among them (``eval_steps_per_s`` measures it, and it is the reference baseline).
+
+    Raises:
+        ValueError: a name that is neither a baseline nor ``ppo``.
+    """
+    if agents is None:
+        return list(BASELINES)
+    unknown = [a for a in agents if a not in BASELINES and a != "ppo"]
+    if unknown:
+        raise ValueError(f"--agents: unknown {unknown}; known: {sorted(BASELINES)} and ppo")
+    return [a for a in BASELINES if a in agents or a == "frontier"]
+
+
 def load_ppo(model: Path) -> Any:
     """The saved model at ``model`` as a policy of the low-level env (torch on one thread; a goal-selection
     MaskablePPO model comes as a ``GoalAgent``), or None with a printed note."""
@@ -110,6 +129,9 @@ def main() -> None:
                          "(repeatable; values parsed as TOML literals)")  # fmt: skip
     ap.add_argument("--generators", nargs="+", default=None, metavar="G",
                     help="run these generators only (default: room rocks caves rooms)")  # fmt: skip
+    ap.add_argument("--agents", nargs="+", default=None, metavar="A",
+                    help="run these agents only: baselines and/or ppo (default: every baseline and ppo); "
+                         "the frontier agent always runs, since eval_steps_per_s measures it")  # fmt: skip
     args = ap.parse_args()
     if (args.address is not None or args.workers is not None) and not args.ray:
         ap.error("--address/--workers: only with --ray")
@@ -117,15 +139,16 @@ def main() -> None:
         common = env_settings(args.set)
         gym.make(ENV_ID, **common).close()  # an unknown key or a bad value: one line, before any episode
         check_generators(args.generators)
+        baselines = chosen_baselines(args.agents)
     except ValueError as exc:
         ap.error(str(exc).splitlines()[0])
     maps, steps = (3, 300) if args.quick else (args.maps, args.steps)
     env = gym.make(ENV_ID, **common)
-    names = list(BASELINES) if not args.ray else ["frontier"]  # with --ray, only eval_steps_per_s runs here
+    names = baselines if not args.ray else ["frontier"]  # with --ray, only eval_steps_per_s runs here
     policies: dict[str, Any] = {name: make_baseline(name, env, seed=0) for name in names}
     env.close()
     extra = {name: dict(common) for name in names}
-    ppo = load_ppo(args.model)
+    ppo = load_ppo(args.model) if args.agents is None or "ppo" in args.agents else None
     if ppo is not None:
         policies["ppo"], extra["ppo"] = ppo, {**model_kwargs(args.model), **common}
         print(f"PPO env keywords: {extra['ppo']}")
@@ -133,8 +156,8 @@ def main() -> None:
         print(f"environment keywords of every agent: {common}")
     t0 = time.perf_counter()
     if args.ray:  # the same policies as specs: baselines sized from ENV_ID with seed 0, the PPO .zip
-        specs = {name: name for name in BASELINES} | ({"ppo": str(args.model)} if ppo is not None else {})
-        extra = {name: dict(common) for name in BASELINES} | extra
+        specs = {name: name for name in baselines} | ({"ppo": str(args.model)} if ppo is not None else {})
+        extra = {name: dict(common) for name in baselines} | extra
         res = run_suite_ray(specs, n_maps=maps, steps=steps, generators=args.generators, agent_env_kwargs=extra,
                             address=args.address, workers=args.workers, policy_env=ENV_ID, policy_seed=0,
                             progress=True)  # fmt: skip
@@ -144,18 +167,18 @@ def main() -> None:
     wall = time.perf_counter() - t0
     print(f"{len(res.results)} generators x {maps} test maps (seeds {res.seeds[0]}..{res.seeds[-1]}), "
           f"{steps} steps, target 1.0; {wall:.0f} s")  # fmt: skip
-    table = res.table(list(BASELINES))
+    table = res.table(baselines)
     print(table)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "leaderboard.md").write_text(table + "\n")
     print(f"wrote {args.out / 'leaderboard.md'}, {res.figure(args.out / 'leaderboard.png')} and "
           f"{res.to_json(args.out / 'suite.json')}")  # fmt: skip
-    best = res.best(list(BASELINES) + (["ppo"] if "ppo" in res.agents else []))
+    best = res.best(baselines + (["ppo"] if "ppo" in res.agents else []))
     record = leaderboard_record(best, float(res.t90()[best].mean()), maps, steps, list(res.results))
     text = json.dumps(record, indent=2) + "\n"
     (args.out / "best.json").write_text(text)  # shipped as agents/data/leaderboard.json (models.LEADERBOARD)
     print(f"wrote {args.out / 'best.json'} (best agent overall: {best})")
-    best = res.best(list(BASELINES))
+    best = res.best(baselines)
     rate = steps_per_second(policies["frontier"], ENV_ID, steps=min(2000, 10 * steps), env_kwargs=common)
     print(f"best_baseline={best}")
     print(f"heuristic_t90_success={res.success(best):.4f}")

@@ -42,3 +42,40 @@ def test_suite_runs_every_agent_on_the_same_test_levels_and_writes_the_leaderboa
     with pytest.raises(ValueError, match="generators"):
         run_suite(agents, n_maps=1, steps=5, generators=["moon"])
     assert set(GENERATORS) == {"room", "rocks", "caves", "rooms"}
+
+
+def test_benchmark_agents_refuses_a_bad_setting_or_generator_in_one_line() -> None:
+    """``--set KEY=VALUE`` (an environment keyword for every agent), ``--generators`` and ``--agents`` are
+    checked before any episode: an unknown keyword, an item without ``=``, an unknown generator or agent is
+    one line, exit 2."""
+    import subprocess
+    import sys
+
+    from digslam.agents.cli.commands import benchmarks_dir
+
+    script = str(benchmarks_dir() / "bench_agents.py")
+    for argv, msg in ((["--set", "bogus=1"], "unknown keyword"), (["--set", "grid_cell"], "expected KEY=VALUE"),
+                      (["--generators", "nope"], "unknown ['nope']"),
+                      (["--agents", "frontier", "nope"], "--agents: unknown ['nope']")):  # fmt: skip
+        out = subprocess.run([sys.executable, script, "--quick", *argv], capture_output=True, text=True)
+        assert out.returncode == 2 and msg in out.stderr.splitlines()[-1], out.stderr[-400:]
+
+
+def test_benchmark_agents_runs_the_agents_it_is_given() -> None:
+    """``--agents`` runs those baselines (the frontier agent always, as ``eval_steps_per_s`` measures it)
+    and the PPO policy only when named; the table and the best baseline are theirs."""
+    import importlib.util
+
+    from digslam.agents.cli.commands import benchmarks_dir
+
+    spec = importlib.util.spec_from_file_location("bench_agents", benchmarks_dir() / "bench_agents.py")
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    from digslam.agents.baselines.registry import BASELINES
+
+    assert mod.chosen_baselines(None) == list(BASELINES)
+    assert mod.chosen_baselines(["lawnmower"]) == [a for a in BASELINES if a in ("frontier", "lawnmower")]
+    assert mod.chosen_baselines(["ppo"]) == ["frontier"]
+    with pytest.raises(ValueError, match="unknown"):
+        mod.chosen_baselines(["frontier", "bogus"])
