@@ -144,8 +144,9 @@ class Auditor:
                       f"{box.tolist()}")  # fmt: skip
         if not hb[0] <= ex.th <= hb[1]:
             self.fail(f"exact heading {ex.th!r} outside the heading box {hb.tolist()}")
-        dig, clear = np.asarray(info["dig"], bool), np.asarray(info["clear"], bool)
-        explored = np.asarray(info["explored"])
+        sets = info if "dig" in info else self.env.get_wrapper_attr("sets")()  # info_sets: the info's copies
+        dig, clear = np.asarray(sets["dig"], bool), np.asarray(sets["clear"], bool)
+        explored = np.asarray(sets["explored"])
         for name, m in (("dig", dig), ("clear", clear), ("explored", explored)):
             if m.shape != self.shape:
                 self.fail(f"info[{name!r}] has shape {m.shape}, the grid {self.shape}")

@@ -112,7 +112,8 @@ class FrameDrawer:
         return (x - self.lo[0]) * self.px, (self.hi[1] - y) * self.px
 
     def frame(self, info: dict[str, Any], step: int) -> Any:
-        """The ``P``-mode frame of ``info`` (the wrapper's info after ``step`` steps)."""
+        """The ``P``-mode frame of ``info`` (the wrapper's info after ``step`` steps; the observer's sets are
+        the info's with ``info_sets=True``, else the layer's now, :meth:`GuaranteedObserver.sets`)."""
         from PIL import Image, ImageDraw
 
         layer = self.layer
@@ -124,7 +125,8 @@ class FrameDrawer:
             self._obstacles, self._world = cells != free, raw.world
         from digslam.observer.thick.sep import CLEAR, DARK
 
-        explored, clear = np.asarray(info["explored"]), np.asarray(info["clear"], bool)
+        sets = info if "explored" in info else layer.sets()  # info_sets: the info's copies
+        explored, clear = np.asarray(sets["explored"]), np.asarray(sets["clear"], bool)
         idx = np.full((self.ny, self.nx), INDEX["penumbra"], np.uint8)
         idx[explored == DARK] = INDEX["dark"]
         idx[clear & (explored == CLEAR)] = INDEX["clear"]

@@ -91,7 +91,7 @@ class DigCoverageEnv(GuaranteedObserver):
 
     # --- pieces of step ------------------------------------------------------------------------------------
     def _reward(self, info: dict[str, Any]) -> float:
-        n = self._certified_count()  # the clear cells of info["clear"] in the reachable free area
+        n = self._certified_count()  # the clear cells in the reachable free area
         gained = max(n - self._clear_count, 0) * self.cell_area
         self._clear_count = n
         return float(gained - self.config.collision_penalty * int(info["truth"].bumps))

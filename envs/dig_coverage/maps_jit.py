@@ -242,7 +242,8 @@ def observe(maps: MapContext, pose_lo: np.ndarray, pose_hi: np.ndarray, heading:
     cells of the position box ``pose_lo``, ``pose_hi``, :func:`~digslam.observer.core.grid_jit.window`)
     and the 11 values of ``state`` (the wrapper's ``"state"``, with the heading interval ``heading``; its
     ``state[9]`` is the share of the grid's cells that are clear, from the observer alone);
-    ``snap`` ``(3, ny, nx)`` uint8 receives copies of the explored codes, the clear mask and ``maps.free``.
+    ``snap`` ``(3, ny, nx)`` uint8 receives copies of the explored codes, the clear mask and ``maps.free``
+    (an empty ``snap``, ``(3, 0, 0)``: no copies).
 
     ``steps`` is the number of elapsed steps and ``n_prev`` the certified count before the step (clear cells
     in ``maps.reach``, ground truth); returns the new count, which enters neither ``img`` nor ``state``. No
@@ -304,19 +305,18 @@ def _observe(maps: MapContext, pose_lo: np.ndarray, pose_hi: np.ndarray, heading
     f8 = free.view(np.uint8).reshape(-1)
     k = e8.size
     s_e, s_c, s_f = s8[:k], s8[k : 2 * k], s8[2 * k :]  # the snapshot: explored, clear, free
-    for i in range(k):  # (slices indexed from 0: no wraparound checks, the loops vectorize)
-        s_e[i] = e8[i]
-    if n_clear >= 0:
-        for i in range(k):
-            s_c[i] = c8[i]
-    else:  # every clear cell of the grid: the state's certified share (no ground truth)
+    if n_clear < 0:  # every clear cell of the grid: the state's certified share (no ground truth)
         n_clear = 0
-        for i in range(k):
-            s_c[i] = c8[i]
+        for i in range(k):  # (slices indexed from 0: no wraparound checks, the loops vectorize)
             n_clear += np.int64(c8[i])
     counts[1] = n_clear
-    for i in range(k):
-        s_f[i] = f8[i]
+    if s8.size:  # the snapshot, when asked for (an empty ``snap``: none)
+        for i in range(k):
+            s_e[i] = e8[i]
+        for i in range(k):
+            s_c[i] = c8[i]
+        for i in range(k):
+            s_f[i] = f8[i]
     b8 = base.reshape(-1)  # flat loops (C-contiguous): they vectorize
     k = b8.size
     o_b, o_p = img.reshape(-1)[:k], img.reshape(-1)[k : k + k // 3]

@@ -22,12 +22,15 @@ much is left to find; the state's value grows with the same clear area but over 
 advance. (It used to be the reachable share, issue #18: the shipped PPO model was trained with that one;
 it still loads and runs, its behaviour may shift.)
 
-``info`` adds the sets as arrays (``explored`` int8 CLEAR/PENUMBRA/DARK, ``dig`` and ``clear`` bool, all
-``(ny, nx)`` with row 0 at the top; ``pose_box (2, 2)``, ``heading_box (2,)``), ``certified_coverage``
+``info`` adds the pose box (``pose_box (2, 2)``, ``heading_box (2,)``), ``certified_coverage``
 (clear cells in the reachable free area over that area, :func:`reachable_free`), ``clear_area`` (m²),
 ``true_coverage`` (the ground truth over the same cells: the share of the reachable free cells whose centre
 was truly sensed, so ``certified_coverage <= true_coverage`` at every step, checked by ``monitor=True``)
-and ``consistent`` / ``inconsistent_step``.
+and ``consistent`` / ``inconsistent_step``; with ``info_sets=True`` (:class:`.config.ObserverConfig`) also
+copies of the sets (``explored`` int8 CLEAR/PENUMBRA/DARK, ``dig`` and ``clear`` bool, all ``(ny, nx)`` with
+row 0 at the top), which :meth:`GuaranteedObserver.sets` gives on demand either way (off by default: three
+full-grid copies a step are about a quarter of the observer's cost on a 256 x 256 grid, and only pictures
+read them).
 If the filter finds the data inconsistent (an empty pose box) it stops, every claim is withdrawn (the map
 becomes all penumbra) and the episode is truncated.
 
@@ -267,7 +270,8 @@ class GuaranteedObserver(gym.Wrapper):
         the observation (:meth:`observation`): one compiled call (:func:`.maps_jit.observe_step`)
         keeps the sets and the map's clear / penumbra / dark channels up to
         date on the cells the step touched (:meth:`OnlineDigSlam.take_touched`) and draws the pose-box channel
-        and the state; ``info`` gets copies of the sets."""
+        and the state. Returns info's copies of the explored codes and the clear mask (empty ``(0, 0)`` arrays
+        without ``info_sets``: not copied), the kept dark mask and the certified count."""
         if self._cache_step != self.steps:
             f, counts = self.filter, self._counts
             win = f.take_touched()
@@ -275,7 +279,8 @@ class GuaranteedObserver(gym.Wrapper):
                 self._clear_all[:] = False  # reachable area may be new): both counts from scratch
                 counts[0], counts[1] = 0, -1
             img, state = np.empty(self._img_shape, np.uint8), np.empty(N_STATE, dtype=np.float32)
-            snap = np.empty(self._snap_shape, np.uint8)  # info's explored, clear and dig
+            # info's explored, clear and dig (info_sets), or nothing (the kernel then copies nothing)
+            snap = np.empty(self._snap_shape if self.obs_config.info_sets else (3, 0, 0), np.uint8)
             observe_step(self._maps, f.pose_lo, f.pose_hi, (f.heading_lo, f.heading_hi), win, self.steps,
                          counts, img, state, snap)  # fmt: skip
             self._n = n = int(counts[0])
@@ -283,7 +288,7 @@ class GuaranteedObserver(gym.Wrapper):
                 self._crop(img)
             self._obs = (img, state)
             self._cache = (snap[0].view(np.int8), snap[1].view(np.bool_), self._dark_all, n)
-            self._dig_copy = snap[2].view(np.bool_)
+            self._dig_copy = snap[2].view(np.bool_)  # (empty without info_sets: never read then)
             self._cache_step = self.steps
         return self._cache
 
@@ -313,19 +318,34 @@ class GuaranteedObserver(gym.Wrapper):
         img, state = self._obs
         return {"map": img, "state": state}
 
+    def sets(self) -> dict[str, np.ndarray]:
+        """Copies of the observer's sets now: ``explored`` (int8 CLEAR / PENUMBRA / DARK), ``dig`` (``M⁻``)
+        and ``clear`` (bool), ``(ny, nx)`` with row 0 at the top; what ``info`` carries with
+        ``info_sets=True`` (once the claims are withdrawn: all penumbra, nothing dug or clear)."""
+        f = self.filter
+        if not f.consistent:
+            shape = self.grid.shape
+            return {"explored": np.full(shape, PENUMBRA, np.int8), "dig": np.zeros(shape, bool),
+                    "clear": np.zeros(shape, bool)}  # fmt: skip
+        self._sets()  # the planes up to date with this step
+        explored, clear = self._explored_all.copy(), self._clear_all.copy()
+        return {"explored": explored, "dig": f.dig.free.copy(), "clear": clear}
+
     def _obs_info(self, info: dict[str, Any]) -> dict[str, Any]:
         f = self.filter
         if f.consistent:
             explored, clear, _, n = self._sets()
-            return {**info, "explored": explored, "dig": self._dig_copy, "clear": clear,
+            if self.obs_config.info_sets:
+                info = {**info, "explored": explored, "dig": self._dig_copy, "clear": clear}
+            return {**info,
                     "pose_box": np.array((f.pose_lo, f.pose_hi), np.float64),
                     "heading_box": np.array((f.heading_lo, f.heading_hi), np.float64),
                     "certified_coverage": n / self.n_reachable, "clear_area": n * self.cell_area,
                     "true_coverage": self.truth_coverage.fraction, "consistent": True,
                     "inconsistent_step": f.inconsistent_step, **self._extra_info}  # fmt: skip
-        shape = self.grid.shape
-        return {**info, "explored": np.full(shape, PENUMBRA), "dig": np.zeros(shape, dtype=bool),
-                "clear": np.zeros(shape, bool), "pose_box": np.full((2, 2), np.nan),
+        if self.obs_config.info_sets:
+            info = {**info, **self.sets()}
+        return {**info, "pose_box": np.full((2, 2), np.nan),
                 "heading_box": np.full(2, np.nan), "certified_coverage": 0 / self.n_reachable,
                 "clear_area": 0 * self.cell_area, "true_coverage": self.truth_coverage.fraction,
                 "consistent": False, "inconsistent_step": f.inconsistent_step,

@@ -151,8 +151,41 @@ def test_observation_state_sets_and_crop() -> None:
     box = info["pose_box"]
     assert box[0, 0] <= x <= box[1, 0] and box[0, 1] <= y <= box[1, 1]
     assert info["heading_box"][0] <= th <= info["heading_box"][1]
-    assert np.all(info["clear"] <= info["dig"]) and np.all((info["explored"] == DARK) <= ~info["clear"])
+    sets = env.sets()
+    assert np.all(sets["clear"] <= sets["dig"]) and np.all((sets["explored"] == DARK) <= ~sets["clear"])
     assert info["clear_area"] == pytest.approx(info["certified_coverage"] * env.n_reachable * env.cell_area)
+    assert np.count_nonzero(sets["clear"] & env.reachable) * env.cell_area == pytest.approx(
+        info["clear_area"]
+    )
+
+
+def test_info_carries_the_sets_only_when_asked() -> None:
+    """``info_sets=False`` (the default): no set in ``info``, ``sets()`` gives them on demand;
+    ``info_sets=True``: ``info`` carries copies equal to ``sets()``, each the caller's own."""
+    plain = gym.make("digslam/DigCoverage-v0", world="rocks")
+    full = gym.make("digslam/DigCoverage-v0", world="rocks", info_sets=True)
+    _, a = plain.reset(seed=5)
+    _, b = full.reset(seed=5)
+    for act in _actions(15, 1):
+        _, _, _, _, a = plain.step(act)
+        _, _, _, _, b = full.step(act)
+    assert not {"explored", "clear", "dig"} & set(a)
+    mine, theirs = plain.get_wrapper_attr("sets")(), full.get_wrapper_attr("sets")()
+    for key in ("explored", "clear", "dig"):
+        assert np.array_equal(mine[key], theirs[key]) and np.array_equal(b[key], theirs[key])
+        assert mine[key].shape == plain.get_wrapper_attr("grid").shape
+    assert mine["clear"].any() and (mine["explored"] == DARK).any()
+    assert mine["explored"].dtype == np.int8 and mine["dig"].dtype == bool and mine["clear"].dtype == bool
+    b["clear"][:] = True  # the copies are the caller's own: the observer's sets are unchanged
+    mine["dig"][:] = True
+    assert (
+        not full.get_wrapper_attr("sets")()["clear"].all()
+        and not plain.get_wrapper_attr("sets")()["dig"].all()
+    )
+    assert (
+        a["certified_coverage"] == b["certified_coverage"]
+        and a["pose_box"].tolist() == b["pose_box"].tolist()
+    )
 
 
 def test_downsampling_is_conservative() -> None:

@@ -86,7 +86,7 @@ def test_issue_adversarial_seeds_tiny_yaw(yaw: float) -> None:
 def test_issue_zero_noise_rocks_vertex_cell() -> None:
     """Zero noise bounds, rocks, seed 960201, ``[1, 2e-12]`` x 200: the cell holding a rock vertex was dug and
     claimed clear at step 196."""
-    env = gym.make("digslam/DigCoverage-v0", world="rocks", noise=ZERO)
+    env = gym.make("digslam/DigCoverage-v0", world="rocks", noise=ZERO, info_sets=True)
     _, info = env.reset(seed=960201)
     aud = Auditor(env, seed=960201)
     aud.reset(info)
@@ -154,7 +154,7 @@ def test_monitor_catches_certified_above_ground_truth() -> None:
 
 # --- the auditor catches false claims ----------------------------------------------------------------------
 def _audited(steps: int = 8) -> tuple[Auditor, dict]:
-    env = gym.make("digslam/DigCoverage-v0", world="rocks")
+    env = gym.make("digslam/DigCoverage-v0", world="rocks", info_sets=True)  # the sets in info, to falsify
     _, info = env.reset(seed=960800)
     aud = Auditor(env, seed=0)
     aud.reset(info)

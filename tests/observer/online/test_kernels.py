@@ -412,14 +412,14 @@ def test_observer_sets_and_map_kernels_match_numpy() -> None:
 
 @pytest.mark.parametrize("window", [0, 3])
 def test_wrapper_sets_kept_up_to_date_equal_the_filter_sets(window: int) -> None:
+    from digslam.envs.dig_coverage.config import ObserverConfig
     from digslam.envs.dig_coverage.maps_jit import three_state as ts
     from digslam.envs.dig_coverage.wrapper import GuaranteedObserver
     from digslam.envs.explore.env import ExploreEnv
     from digslam.observer.online.observer import OnlineConfig
 
-    env = GuaranteedObserver(
-        ExploreEnv(world="rocks"), map_size=48, config=OnlineConfig(smoothing_window=window)
-    )
+    cfg = ObserverConfig(map_size=48, info_sets=True, online=OnlineConfig(smoothing_window=window))
+    env = GuaranteedObserver(ExploreEnv(world="rocks"), config=cfg)
     rng = np.random.default_rng(window)
     for episode in range(2):
         obs, info = env.reset(seed=episode)
