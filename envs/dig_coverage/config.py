@@ -50,7 +50,7 @@ class ObserverConfig(Config):
             :mod:`.monitor`).
         start_box: Half-width (m) of the initial position box around the true start.
         info_sets: Put copies of the observer's sets (``explored``, ``clear``, ``dig``: full grids) in every
-            step's ``info``. Off by default: the three copies are about a quarter of the observer's cost on a
+            step's ``info``. Off by default: the three copies are about a fifth of the observer's cost on a
             256 x 256 grid and nothing in training or evaluation reads them; the wrapper's ``sets()`` gives
             the same copies on demand, and the pictures turn them on.
         horizon: Steps that normalise the elapsed time in ``"state"`` (the registered step limit).

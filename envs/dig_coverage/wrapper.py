@@ -29,7 +29,7 @@ was truly sensed, so ``certified_coverage <= true_coverage`` at every step, chec
 and ``consistent`` / ``inconsistent_step``; with ``info_sets=True`` (:class:`.config.ObserverConfig`) also
 copies of the sets (``explored`` int8 CLEAR/PENUMBRA/DARK, ``dig`` and ``clear`` bool, all ``(ny, nx)`` with
 row 0 at the top), which :meth:`GuaranteedObserver.sets` gives on demand either way (off by default: three
-full-grid copies a step are about a quarter of the observer's cost on a 256 x 256 grid, and only pictures
+full-grid copies a step are about a fifth of the observer's cost on a 256 x 256 grid, and only pictures
 read them).
 If the filter finds the data inconsistent (an empty pose box) it stops, every claim is withdrawn (the map
 becomes all penumbra) and the episode is truncated.
