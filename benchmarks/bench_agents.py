@@ -23,7 +23,7 @@ Usage: ``python benchmarks/bench_agents.py [--quick] [--maps 30] [--steps 3000] 
 grid_cell=0.078125``: the observer on a grid twice as fine; ``--set 'noise={speed=0.0, yaw_rate=0.0}'``:
 exact odometry, the certified ceiling of a planner when the pose box does not drift); ``--generators`` runs
 some generators only; ``--agents`` some agents only (``--agents frontier``: the reference baseline alone,
-about 150 s for the full suite; the best baseline and ``heuristic_t90_success`` are then those of the agents
+about 6 minutes for the full suite on a 2-core machine; the best baseline and ``heuristic_t90_success`` are then those of the agents
 run).
 The full suite (4 generators x 30 maps x 3000 steps x 5 agents, about 1.8 M steps) takes roughly half an
 hour on one core (the frontier

@@ -52,7 +52,7 @@ class ObserverConfig(Config):
         info_sets: Put copies of the observer's sets (``explored``, ``clear``, ``dig``: full grids) in every
             step's ``info``. Off by default: the three copies are about a fifth of the observer's cost on a
             256 x 256 grid and nothing in training or evaluation reads them; the wrapper's ``sets()`` gives
-            the same copies on demand, and the pictures turn them on.
+            the same copies on demand (the pictures read them there).
         horizon: Steps that normalise the elapsed time in ``"state"`` (the registered step limit).
         online: Settings of the online filter (an ``OnlineConfig`` or a mapping).
         q: Outliers allowed among the range readings of one step: the filter's q-relaxed mode

@@ -62,8 +62,8 @@ def test_benchmark_agents_refuses_a_bad_setting_or_generator_in_one_line() -> No
 
 
 def test_benchmark_agents_runs_the_agents_it_is_given() -> None:
-    """``--agents`` runs those baselines (the frontier agent always, as ``eval_steps_per_s`` measures it)
-    and the PPO policy only when named; the table and the best baseline are theirs."""
+    """``--agents`` picks the baselines it names, in the registry's order, the frontier agent always among
+    them (``eval_steps_per_s`` measures it); ``ppo`` alone leaves the frontier agent; a bad name raises."""
     import importlib.util
 
     from digslam.agents.cli.commands import benchmarks_dir
