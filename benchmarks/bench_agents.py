@@ -1,8 +1,9 @@
 """The coverage benchmark: every agent on the test levels of every generator, certified coverage uncapped.
 
-Every baseline of :data:`digslam.agents.baselines.registry.BASELINES` (and the PPO policy
-``agents/data/ppo_digcoverage.zip`` when it exists, on the env keywords of its ``.json`` sidecar: they
-change the observation, not the levels) runs on the same ``--maps`` levels of each generator of
+Every baseline of :data:`digslam.agents.baselines.registry.BASELINES` (and the shipped learned agent
+``agents/data/goals_attention.zip``, row ``ppo``, and the low-level PPO ``agents/data/ppo_digcoverage.zip``,
+row ``ppo_lowlevel``, when they exist, each on the env keywords of its ``.json`` sidecar: they change the
+observation, not the levels) runs on the same ``--maps`` levels of each generator of
 :data:`digslam.agents.evaluation.suite.GENERATORS` (room, rocks, caves, rooms): the first seeds of the test
 split (``digslam.envs.splits``), ``target=1.0`` (no early end), ``--steps`` steps
 (:func:`digslam.agents.evaluation.suite.run_suite`). Prints the leaderboard (T90 per generator with its
@@ -51,7 +52,11 @@ from digslam.agents.evaluation.suite import check_generators, run_suite, steps_p
 from digslam.agents.learning.models import leaderboard_record
 
 ENV_ID = "digslam/DigCoverage-v0"
-MODEL = Path(__file__).resolve().parents[1] / "agents" / "data" / "ppo_digcoverage.zip"
+MODEL = Path(__file__).resolve().parents[1] / "agents" / "data" / "goals_attention.zip"
+#: The low-level PPO policy (continuous actions on the map), a comparison row (``ppo_lowlevel``).
+LOWLEVEL = Path(__file__).resolve().parents[1] / "agents" / "data" / "ppo_digcoverage.zip"
+#: The learned rows: ``ppo`` (``--model``) and ``ppo_lowlevel`` (``--lowlevel``).
+LEARNED = ("ppo", "ppo_lowlevel")
 
 
 def model_kwargs(model: Path) -> dict[str, Any]:
@@ -88,9 +93,9 @@ def chosen_baselines(agents: list[str] | None) -> list[str]:
     """
     if agents is None:
         return list(BASELINES)
-    unknown = [a for a in agents if a not in BASELINES and a != "ppo"]
+    unknown = [a for a in agents if a not in BASELINES and a not in LEARNED]
     if unknown:
-        raise ValueError(f"--agents: unknown {unknown}; known: {sorted(BASELINES)} and ppo")
+        raise ValueError(f"--agents: unknown {unknown}; known: {sorted(BASELINES)}, {', '.join(LEARNED)}")
     return [a for a in BASELINES if a in agents or a == "frontier"]
 
 
@@ -98,7 +103,7 @@ def load_ppo(model: Path) -> Any:
     """The saved model at ``model`` as a policy of the low-level env (torch on one thread; a goal-selection
     MaskablePPO model comes as a ``GoalAgent``), or None with a printed note."""
     if not model.is_file():
-        print(f"note: no PPO model at {model}; PPO skipped")
+        print(f"note: no PPO model at {model}; skipped")
         return None
     try:
         from digslam.agents.learning.models import load_ppo as load
@@ -117,7 +122,9 @@ def main() -> None:
     ap.add_argument("--maps", type=int, default=30, help="test levels per generator (default 30)")
     ap.add_argument("--steps", type=int, default=3000, help="steps per episode (default 3000)")
     ap.add_argument("--quick", action="store_true", help="a smoke run: 3 maps, 300 steps")
-    ap.add_argument("--model", type=Path, default=MODEL, help="PPO model (.zip)")
+    ap.add_argument("--model", type=Path, default=MODEL, help="the learned model of the ppo row (.zip)")
+    ap.add_argument("--lowlevel", type=Path, default=LOWLEVEL,
+                    help="the model of the ppo_lowlevel row (.zip; default the shipped low-level PPO)")  # fmt: skip
     ap.add_argument(
         "--out", type=Path, default=Path("out/leaderboard"), help="where to write the leaderboard"
     )
@@ -130,7 +137,7 @@ def main() -> None:
     ap.add_argument("--generators", nargs="+", default=None, metavar="G",
                     help="run these generators only (default: room rocks caves rooms)")  # fmt: skip
     ap.add_argument("--agents", nargs="+", default=None, metavar="A",
-                    help="run these agents only: baselines and/or ppo (default: every baseline and ppo); "
+                    help="run these agents only: baselines, ppo and/or ppo_lowlevel (default: all of them); "
                          "the frontier agent always runs, since eval_steps_per_s measures it")  # fmt: skip
     args = ap.parse_args()
     if (args.address is not None or args.workers is not None) and not args.ray:
@@ -152,11 +159,18 @@ def main() -> None:
     if ppo is not None:
         policies["ppo"], extra["ppo"] = ppo, {**model_kwargs(args.model), **common}
         print(f"PPO env keywords: {extra['ppo']}")
+    low = None
+    wanted = args.agents is None or "ppo_lowlevel" in args.agents
+    if wanted and args.lowlevel.resolve() != args.model.resolve():  # the same file is one row, ppo
+        low = load_ppo(args.lowlevel)
+    if low is not None:
+        policies["ppo_lowlevel"], extra["ppo_lowlevel"] = low, {**model_kwargs(args.lowlevel), **common}
     if common:
         print(f"environment keywords of every agent: {common}")
     t0 = time.perf_counter()
     if args.ray:  # the same policies as specs: baselines sized from ENV_ID with seed 0, the PPO .zip
         specs = {name: name for name in baselines} | ({"ppo": str(args.model)} if ppo is not None else {})
+        specs |= {"ppo_lowlevel": str(args.lowlevel)} if low is not None else {}
         extra = {name: dict(common) for name in baselines} | extra
         res = run_suite_ray(specs, n_maps=maps, steps=steps, generators=args.generators, agent_env_kwargs=extra,
                             address=args.address, workers=args.workers, policy_env=ENV_ID, policy_seed=0,
@@ -173,7 +187,7 @@ def main() -> None:
     (args.out / "leaderboard.md").write_text(table + "\n")
     print(f"wrote {args.out / 'leaderboard.md'}, {res.figure(args.out / 'leaderboard.png')} and "
           f"{res.to_json(args.out / 'suite.json')}")  # fmt: skip
-    best = res.best(baselines + (["ppo"] if "ppo" in res.agents else []))
+    best = res.best(baselines + [a for a in LEARNED if a in res.agents])
     record = leaderboard_record(best, float(res.t90()[best].mean()), maps, steps, list(res.results))
     text = json.dumps(record, indent=2) + "\n"
     (args.out / "best.json").write_text(text)  # shipped as agents/data/leaderboard.json (models.LEADERBOARD)

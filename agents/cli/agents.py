@@ -86,14 +86,15 @@ def resolve_agent(name: str, env_id: str, model: Path | None) -> tuple[str, Any,
     try:
         if name == "ppo" and model is None:
             try:
+                import sb3_contrib  # noqa: F401
                 import stable_baselines3  # noqa: F401
             except ImportError:
-                warnings.warn("the shipped PPO policy needs stable-baselines3 and torch (pip install "
-                              '"digslam[train]"); using the frontier agent', stacklevel=2)  # fmt: skip
+                need = 'stable-baselines3, sb3-contrib and torch (pip install "digslam[train]")'
+                warnings.warn(f"the shipped learned agent needs {need}; using frontier", stacklevel=2)
                 return "frontier", load_agent("frontier", env), kwargs
             if not pretrained.is_file():
                 warnings.warn(
-                    f"no shipped PPO policy at {pretrained}; using the frontier agent", stacklevel=2
+                    f"no shipped learned agent at {pretrained}; using the frontier agent", stacklevel=2
                 )
                 return "frontier", load_agent("frontier", env), kwargs
         return name, load_agent(name, env, model), kwargs

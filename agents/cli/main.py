@@ -2,7 +2,7 @@
 
 ``digslam demo`` runs ``digslam/DigCoverage-v0`` with the best agent of the leaderboard shipped in
 ``digslam/agents/data/leaderboard.json`` (``--agent best``, the default; it prints which agent that is and
-why; ``--agent ppo`` runs the shipped PPO policy), writes the episode GIF and the certified-coverage figure
+why; ``--agent ppo`` runs the shipped learned agent), writes the episode GIF and the certified-coverage figure
 to ``--out`` and prints the certified coverage reached. Every
 subcommand has ``--help``; heavy imports (torch, SB3, matplotlib) happen only when a subcommand needs them.
 

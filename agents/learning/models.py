@@ -1,10 +1,14 @@
 """The model registry: the shipped PPO policy, the environment it was trained on, loading a saved model.
 
-:data:`PRETRAINED` is the policy shipped in ``digslam/agents/data`` (see its ``README.md``), trained on
-:data:`DEFAULT_ENV` with the environment keywords of its ``.json`` sidecar (:func:`model_env_kwargs`; every
-model saved by ``digslam train`` has one). :func:`load_ppo` reads a saved PPO ``.zip`` and checks it against
-an environment's observation space. A model or sidecar that cannot be used raises :class:`ModelError` (a
-``ValueError``) in one line that names the file and says what to do; the command line shows it as is.
+:data:`PRETRAINED` is the learned agent shipped in ``digslam/agents/data`` (see its ``README.md``): a
+goal-level ``MaskablePPO`` (attention over the candidate goals, warm-started by imitation of a look-ahead
+teacher) that acts in :data:`DEFAULT_ENV` through the goal driver, with the environment keywords of its
+``.json`` sidecar (:func:`model_env_kwargs`; every model saved by ``digslam train`` has one).
+:data:`LOWLEVEL` is the former shipped policy, a low-level PPO steering ``(v, ω)`` from the map, kept as a
+comparison row of the benchmark (``ppo_lowlevel``). :func:`load_ppo` reads a saved PPO ``.zip`` and
+checks it against an environment's observation space. A model or sidecar that cannot be used raises
+:class:`ModelError` (a ``ValueError``) in one line that names the file and says what to do; the command line
+shows it as is.
 
 **Goal-level models.** A model whose sidecar names a goal-selection env (``digslam/DigCoverageGoals*``,
 :mod:`digslam.agents.goals`; sb3-contrib's ``MaskablePPO``, ``algo = "maskable_ppo"``) picks candidate goals,
@@ -17,9 +21,11 @@ not low-level actions: :func:`load_ppo` returns it inside a
 
 Torch, stable-baselines3 and sb3-contrib are imported only by :func:`load_ppo`.
 
->>> DEFAULT_ENV, PRETRAINED.name
-('digslam/DigCoverage-v0', 'ppo_digcoverage.zip')
->>> sorted(model_env_kwargs())  # the sidecar's keywords, less the training-only ones (``fixed_world``)
+>>> DEFAULT_ENV, PRETRAINED.name, LOWLEVEL.name
+('digslam/DigCoverage-v0', 'goals_attention.zip', 'ppo_digcoverage.zip')
+>>> model_env_kwargs()  # the low-level env of a goal model: its horizon (the training levels are left out)
+{'horizon': 3000}
+>>> sorted(model_env_kwargs(LOWLEVEL))  # the sidecar's keywords, less the training-only ones
 ['crop', 'dynamics', 'map_size']
 """
 
@@ -31,8 +37,11 @@ from typing import Any
 
 #: The folder of the shipped model (and of its sidecar and README).
 DATA = Path(__file__).parents[1] / "data"
-#: The shipped policy; the environment keywords it was trained with are in ``<model>.json``.
-PRETRAINED = DATA / "ppo_digcoverage.zip"
+#: The shipped learned agent (``--agent ppo``); the environment keywords it was trained with are in
+#: ``<model>.json``.
+PRETRAINED = DATA / "goals_attention.zip"
+#: The shipped low-level PPO policy (continuous steering from the map), a comparison row of the benchmark.
+LOWLEVEL = DATA / "ppo_digcoverage.zip"
 #: The best agent of the last full leaderboard run (``benchmarks/bench_agents.py`` writes ``best.json`` to
 #: its ``--out``; the shipped copy lives here): ``digslam demo``'s default agent (:func:`best_agent`). Its
 #: ``ppo`` means :data:`PRETRAINED`: ship a leaderboard won by a learned model together with that model.
@@ -44,8 +53,9 @@ DEFAULT_ENV = "digslam/DigCoverage-v0"
 #: The package of the goal-selection envs (:func:`~.train.env_module` of their ids).
 GOALS = "digslam.agents.goals"
 #: Environment keywords of a training run that are no part of what the model sees (the levels it trained
-#: on among them: each command picks its own, the benchmark each generator of its suite).
-TRAINING_ONLY = ("fixed_world", "max_episode_steps", "render_mode", "world", "map_seed")
+#: on among them: each command picks its own, the benchmark each generator of its suite; and the coverage
+#: that ended its training episodes: the benchmark runs to its step budget).
+TRAINING_ONLY = ("fixed_world", "max_episode_steps", "render_mode", "world", "map_seed", "target")
 
 
 class ModelError(ValueError):
@@ -218,6 +228,7 @@ def _goal_agent(model: Any, path: Path, env: Any, meta: dict[str, Any], opt: str
     return agent
 
 
-__all__ = ["DATA", "DEFAULT_ENV", "GOALS", "LEADERBOARD", "PRETRAINED", "TRAINING_ONLY", "ModelError",
+__all__ = ["DATA", "DEFAULT_ENV", "GOALS", "LEADERBOARD", "LOWLEVEL", "PRETRAINED", "TRAINING_ONLY",
+           "ModelError",
            "as_policy", "best_agent", "goal_env_id", "leaderboard_record", "load_ppo", "model_env_kwargs",
            "model_meta"]  # fmt: skip

@@ -32,7 +32,9 @@ from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
+import numpy as np
 
+from digslam.agents.goals.teacher import TEACHERS
 from digslam.agents.learning.wrappers import ACTION_MODES, wrap_training_env
 from digslam.envs.splits import VALIDATION, check_not_test
 from digslam.observer.core.config import Config, config_dataclass
@@ -86,6 +88,18 @@ class TrainConfig(Config):
         heuristic_prior: With ``maskable_ppo``: the initial logit of candidate ``k`` is
             ``heuristic_prior * (1 - k / K)`` (the candidates come sorted by the frontier heuristic's cost,
             so the untrained policy already prefers the heuristic's pick; 0: uniform).
+        policy: With ``maskable_ppo``: ``"attention"`` (:class:`~.attention.CandidateAttentionPolicy`: one
+            network scores every candidate, after self-attention over the valid ones; ``features_dim`` is a
+            candidate's vector) or ``"mlp"`` (an MLP on the flattened candidate features and globals).
+        warm_start: With ``maskable_ppo``, before PPO: ``"frontier"`` or ``"rollout"``, the teacher whose
+            picks the policy is first fitted to (:mod:`.warm_start`; ``""``: none). The fitted policy is also
+            saved as ``warm_start_model.zip``.
+        warm_start_levels: Training levels of the first warm-start round (seeds from
+            :data:`.warm_start.DEMO_SEED` on; every round plays new ones).
+        warm_start_rounds: Rounds of the warm start: the teacher drives the first; in each further one the
+            policy fitted so far drives and the teacher labels its decisions (DAgger).
+        dagger_levels: Levels of each round after the first (0: ``warm_start_levels``).
+        bc_epochs: Epochs of the behaviour-cloning fit (each round).
     """
 
     env_id: str = "digslam/DigCoverage-v0"
@@ -113,6 +127,12 @@ class TrainConfig(Config):
     tube_penalty: float = 0.0
     algo: str = "ppo"
     heuristic_prior: float = 0.0
+    policy: str = "mlp"
+    warm_start: str = ""
+    warm_start_levels: int = 16
+    warm_start_rounds: int = 1
+    dagger_levels: int = 0
+    bc_epochs: int = 20
     resume: bool = False
 
     def __post_init__(self) -> None:
@@ -124,17 +144,26 @@ class TrainConfig(Config):
             elif not isinstance(v, want) or (want is int and isinstance(v, bool)):
                 raise ValueError(f"{f.name}: must be {want.__name__}, got {v!r} ({type(v).__name__})")
         positive = ("n_envs", "total_timesteps", "n_steps", "batch_size", "n_epochs", "features_dim",
-                    "eval_maps", "torch_threads")  # fmt: skip
+                    "eval_maps", "torch_threads", "warm_start_levels", "warm_start_rounds",
+                    "bc_epochs")  # fmt: skip
         for name in positive:
             if getattr(self, name) < 1:
                 raise ValueError(f"{name}: must be >= 1, got {getattr(self, name)!r}")
-        for name in ("eval_freq", "checkpoint_freq", "ent_coef", "seed", "eval_seed"):
+        for name in ("eval_freq", "checkpoint_freq", "ent_coef", "seed", "eval_seed", "dagger_levels"):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name}: must be >= 0, got {getattr(self, name)!r}")
         if self.actions not in ACTION_MODES:
             raise ValueError(f"actions: must be one of {ACTION_MODES}, got {self.actions!r}")
         if self.algo not in ALGOS:
             raise ValueError(f"algo: must be one of {ALGOS}, got {self.algo!r}")
+        if self.policy not in POLICIES:
+            raise ValueError(f"policy: must be one of {POLICIES}, got {self.policy!r}")
+        if self.warm_start not in ("", *TEACHERS):
+            raise ValueError(f"warm_start: must be one of {('', *TEACHERS)}, got {self.warm_start!r}")
+        if self.warm_start and self.algo != "maskable_ppo":
+            raise ValueError('warm_start: a teacher picks candidate goals; it needs algo = "maskable_ppo"')
+        if self.policy == "attention" and self.algo != "maskable_ppo":
+            raise ValueError('policy: "attention" scores candidate goals; it needs algo = "maskable_ppo"')
         if not (math.isfinite(self.heuristic_prior) and self.heuristic_prior >= 0):
             raise ValueError(f"heuristic_prior: must be finite and >= 0, got {self.heuristic_prior!r}")
         if not (math.isfinite(self.tube_penalty) and self.tube_penalty >= 0):
@@ -271,6 +300,8 @@ def make_vec_env(factory: EnvFactory, n: int, seed: int) -> Any:
 
 #: The learning algorithms of :class:`TrainConfig` (``algo``).
 ALGOS = ("ppo", "maskable_ppo")
+#: The goal-selection networks of :class:`TrainConfig` (``policy``).
+POLICIES = ("mlp", "attention")
 
 
 def env_module(env_id: str) -> str:
@@ -288,12 +319,20 @@ def _ppo_kwargs(cfg: TrainConfig, tensorboard_log: str | None) -> dict[str, Any]
 
 
 def build_maskable(cfg: TrainConfig, env: Any, tensorboard_log: str | None = None) -> Any:
-    """sb3-contrib's ``MaskablePPO`` of ``cfg`` on the vectorized goal-selection ``env``: an MLP on the
-    flattened candidate features and globals (``MultiInputPolicy``), the action logits' bias set to the
-    heuristic's ranking (``cfg.heuristic_prior``)."""
+    """sb3-contrib's ``MaskablePPO`` of ``cfg`` on the vectorized goal-selection ``env``, its logits started
+    from the heuristic's ranking (``cfg.heuristic_prior``): with ``policy = "attention"``
+    :class:`~.attention.CandidateAttentionPolicy` (``d = features_dim``), else an MLP on the flattened
+    candidate features and globals (``MultiInputPolicy``) whose output bias carries the prior."""
     import torch
     from sb3_contrib import MaskablePPO
 
+    if cfg.policy == "attention":
+        from digslam.agents.learning.attention import CandidateAttentionPolicy
+
+        heads = 4 if cfg.features_dim % 4 == 0 else 1
+        kw = {"d": cfg.features_dim, "heads": heads, "heuristic_prior": cfg.heuristic_prior}
+        ppo = _ppo_kwargs(cfg, tensorboard_log)
+        return MaskablePPO(CandidateAttentionPolicy, env, policy_kwargs=kw, **ppo)
     arch = {"pi": [cfg.features_dim, 64], "vf": [cfg.features_dim, 64]}
     model = MaskablePPO(
         "MultiInputPolicy", env, policy_kwargs={"net_arch": arch}, **_ppo_kwargs(cfg, tensorboard_log)
@@ -430,6 +469,8 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = N
             )
         last = latest_checkpoint(out) if cfg.resume else None
         model = build_model(cfg, env, tb) if last is None else load_model(cfg, last[0], env, tb)
+        if last is None and cfg.warm_start:
+            _warm_start(cfg, model, out)
         todo = cfg.total_timesteps - (last[1] if last is not None else 0)
         if last is not None and cfg.verbose:
             print(f"resuming from {last[0]} at {last[1]} timesteps")
@@ -462,6 +503,38 @@ def train(cfg: TrainConfig, callbacks: Sequence[Any] = (), worker_guard: Any = N
         if eval_env is not None:
             eval_env.close()
     return path
+
+
+def _warm_start(cfg: TrainConfig, model: Any, out: Path) -> None:
+    """Fit ``model`` to ``cfg.warm_start``'s picks (:mod:`.warm_start`): the teacher drives the first
+    ``warm_start_levels`` levels; in each further round (``warm_start_rounds``) the policy fitted so far
+    drives ``dagger_levels`` new levels (default as many) while the teacher labels its decisions (DAgger),
+    and the fit goes on over everything. Saves ``warm_start_model.zip`` and ``warm_start.json``
+    (decisions, the teacher's share of non-first picks, accuracy per epoch, per round)."""
+    from digslam.agents.learning import warm_start as ws
+
+    say = print if cfg.verbose else None
+    n, more = cfg.warm_start_levels, cfg.dagger_levels or cfg.warm_start_levels
+    rounds: list[dict[str, Any]] = []
+    parts: list[dict[str, np.ndarray]] = []
+    for r in range(cfg.warm_start_rounds):
+        actor = None
+        if r:
+            actor = out / f"warm_start_round{r}.zip"
+            _save(model, actor, cfg)
+        first, size = (0, n) if r == 0 else (n + (r - 1) * more, more)
+        parts.append(ws.collect(cfg.env_id, cfg.env_kwargs, cfg.warm_start, size, out, workers=cfg.n_envs,
+                                log=say, first=first, actor=actor))  # fmt: skip
+        data = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+        acc = ws.clone(model, data, epochs=cfg.bc_epochs, seed=cfg.seed + r)
+        picks = data["action"]
+        rounds.append({"decisions": int(len(picks)), "not_first": float(np.mean(picks != 0)),
+                       "accuracy": acc})  # fmt: skip
+        if say is not None:
+            say(f"warm start round {r}: {rounds[-1]['decisions']} decisions, accuracy {acc[-1]:.3f}")
+    report = {"teacher": cfg.warm_start, "levels": n + more * (cfg.warm_start_rounds - 1), "rounds": rounds}
+    (out / "warm_start.json").write_text(json.dumps(report, indent=2))
+    _save(model, out / "warm_start_model.zip", cfg)
 
 
 def write_sidecar(path: Path, cfg: TrainConfig) -> Path:
@@ -497,4 +570,4 @@ def _has_progress() -> bool:
 
 __all__ = ["DEFAULT_CONFIG", "EnvFactory", "SeedCycle", "TrainConfig", "TrainingInterrupted", "build_model",
            "make_vec_env", "parse_value", "pin_threads", "train", "write_sidecar", "ALGOS", "build_maskable",
-           "env_module", "latest_checkpoint", "load_model"]  # fmt: skip
+           "env_module", "latest_checkpoint", "load_model", "POLICIES"]  # fmt: skip

@@ -77,5 +77,6 @@ def test_benchmark_agents_runs_the_agents_it_is_given() -> None:
     assert mod.chosen_baselines(None) == list(BASELINES)
     assert mod.chosen_baselines(["lawnmower"]) == [a for a in BASELINES if a in ("frontier", "lawnmower")]
     assert mod.chosen_baselines(["ppo"]) == ["frontier"]
+    assert mod.chosen_baselines(["ppo_lowlevel", "ppo"]) == ["frontier"]  # the learned rows are no baselines
     with pytest.raises(ValueError, match="unknown"):
         mod.chosen_baselines(["frontier", "bogus"])
