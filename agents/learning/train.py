@@ -91,7 +91,8 @@ class TrainConfig(Config):
         policy: With ``maskable_ppo``: ``"attention"`` (:class:`~.attention.CandidateAttentionPolicy`: one
             network scores every candidate, after self-attention over the valid ones; ``features_dim`` is a
             candidate's vector) or ``"mlp"`` (an MLP on the flattened candidate features and globals).
-        warm_start: With ``maskable_ppo``, before PPO: ``"frontier"`` or ``"rollout"``, the teacher whose
+        warm_start: With ``maskable_ppo``, before PPO: ``"frontier"``, ``"rollout"`` or
+            ``"rollout_fresh_noise"`` (:data:`~digslam.agents.goals.teacher.TEACHERS`), the teacher whose
             picks the policy is first fitted to (:mod:`.warm_start`; ``""``: none). The fitted policy is also
             saved as ``warm_start_model.zip``.
         warm_start_levels: Training levels of the first warm-start round (seeds from

@@ -1,9 +1,10 @@
 """Behaviour-cloning warm start of a goal-level learner (``warm_start`` in :class:`~.train.TrainConfig`).
 
 Before PPO's first update, :func:`warm_start` plays a teacher (:mod:`digslam.agents.goals.teacher`:
-``"frontier"``, the frontier agent's pick, or ``"rollout"``, a one-step look-ahead over copies of the
-simulator) on ``warm_start_levels`` training levels of the run's goal env, then fits the policy to the
-teacher's picks by cross-entropy over the valid candidates (:func:`clone`). The levels are the train split's
+``"frontier"``, the frontier agent's pick, ``"rollout"``, a one-step look-ahead over copies of the
+simulator, or ``"rollout_fresh_noise"``, the same with noise of each copy's own) on ``warm_start_levels``
+training levels of the run's goal env, then fits the policy to the teacher's picks by cross-entropy over
+the valid candidates (:func:`clone`). The levels are the train split's
 seeds from :data:`DEMO_SEED` on (never the validation or test split). Each level's decisions are saved as
 ``<out_dir>/demonstrations/level_<seed>.npz`` the moment they are recorded, and a level already there is
 not played again: an interrupted warm start resumes where it stopped. The levels are played by ``n_envs``
