@@ -18,10 +18,11 @@ simulator, so these are not agents' figures: they bound what imitating the teach
 gap says how much of it came from knowing the noise to come.
 
 Usage: ``python benchmarks/bench_teacher.py [--quick] [--levels 6] [--generators G ...] [--workers 2]``.
-``--quick`` runs 2 room levels (about half a minute); the default (6 levels of 3 generators) about 7
+``--quick`` runs 2 room levels (about half a minute); the default (6 levels of 3 generators) about 8
 minutes on a 2-core machine, most of it the teachers on the rocks. Measured (default):
 ``rollout_speedup_t90=1.1556 [1.0032, 1.3358]`` (room 1.111, caves 1.124, rocks 1.235) and
-``fresh_noise_speedup_t90=1.1419 [1.0137, 1.2967]`` (room 1.140, caves 1.166, rocks 1.120).
+``fresh_noise_speedup_t90=1.1758 [1.0199, 1.3565]`` (room 1.089, caves 1.210, rocks 1.233; the fresh-noise
+teacher's streams are seeded by the level).
 """
 
 from __future__ import annotations
@@ -54,7 +55,7 @@ def play(job: tuple[str, int, str, int]) -> dict[str, Any]:
     from digslam.agents.goals.teacher import teacher
 
     env = gym.make(GOAL_ID, target=TARGET, max_steps=max_steps, **GENERATORS[generator][1])
-    choose = teacher("frontier" if mode == "frontier" else mode)
+    choose = teacher(mode, seed=seed) if mode == "rollout_fresh_noise" else teacher(mode)
     t0 = time.perf_counter()
     obs, info = env.reset(seed=seed)
     done = cut = False

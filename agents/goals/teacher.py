@@ -11,7 +11,7 @@
   random stream, ``fresh_noise=True``) instead of the noise the episode will draw: its picks cannot ride
   on a lucky draw to come, only on the world's layout. On 6 validation levels each of room, caves and
   rocks (target 0.9; ``benchmarks/bench_teacher.py``) both beat the frontier agent by about the same (T90
-  speedup 1.156 and 1.142), so the look-ahead's gain is the layout behind the frontiers, not the noise.
+  speedup 1.156 and 1.176), so the look-ahead's gain is the layout behind the frontiers, not the noise.
 
 **Ground truth.** The rollout teacher steps *copies of the simulator*: it sees the world and the noise to
 come, which no agent may. It exists only to label training decisions; the labels are candidate indices of

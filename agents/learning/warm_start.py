@@ -58,7 +58,10 @@ def _play(job: tuple[str, Mapping[str, Any], str, Mapping[str, Any], int, str, s
             return int(model.predict(obs, action_masks=np.asarray(obs["mask"]) > 0, deterministic=True)[0])
 
     lines: list[str] = []
-    data = demonstrations(env, teacher(name, **dict(teacher_kwargs)), [seed], log=lines.append, act=act)
+    kwargs = dict(teacher_kwargs)
+    if name == "rollout_fresh_noise":
+        kwargs.setdefault("seed", seed)  # each level's copies draw streams of their own
+    data = demonstrations(env, teacher(name, **kwargs), [seed], log=lines.append, act=act)
     env.close()
     tmp = Path(path).with_suffix(".part.npz")
     np.savez_compressed(tmp, **data)
