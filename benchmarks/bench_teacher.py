@@ -55,7 +55,7 @@ def play(job: tuple[str, int, str, int]) -> dict[str, Any]:
     from digslam.agents.goals.teacher import teacher
 
     env = gym.make(GOAL_ID, target=TARGET, max_steps=max_steps, **GENERATORS[generator][1])
-    choose = teacher(mode, seed=seed) if mode == "rollout_fresh_noise" else teacher(mode)
+    choose = teacher(mode, seed=seed)
     t0 = time.perf_counter()
     obs, info = env.reset(seed=seed)
     done = cut = False

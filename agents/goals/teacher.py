@@ -83,7 +83,8 @@ class RolloutTeacher:
 
 
 def teacher(name: str, **kwargs: Any) -> Callable[[Any, dict[str, np.ndarray]], int]:
-    """``choose(env, obs) -> action`` of the teacher ``name`` (:data:`TEACHERS`)."""
+    """``choose(env, obs) -> action`` of the teacher ``name`` (:data:`TEACHERS`); ``kwargs`` go to
+    :class:`RolloutTeacher` (the frontier teacher takes none and ignores them)."""
     if name == "frontier":
         return lambda env, obs: 0
     if name == "rollout":

@@ -58,10 +58,8 @@ def _play(job: tuple[str, Mapping[str, Any], str, Mapping[str, Any], int, str, s
             return int(model.predict(obs, action_masks=np.asarray(obs["mask"]) > 0, deterministic=True)[0])
 
     lines: list[str] = []
-    kwargs = dict(teacher_kwargs)
-    if name == "rollout_fresh_noise":
-        kwargs.setdefault("seed", seed)  # each level's copies draw streams of their own
-    data = demonstrations(env, teacher(name, **kwargs), [seed], log=lines.append, act=act)
+    choose = teacher(name, **{"seed": seed, **teacher_kwargs})  # fresh noise: each level's streams its own
+    data = demonstrations(env, choose, [seed], log=lines.append, act=act)
     env.close()
     tmp = Path(path).with_suffix(".part.npz")
     np.savez_compressed(tmp, **data)
