@@ -101,8 +101,12 @@ class ExploreConfig(Config):
         dynamics: ``pymunk`` (rigid-body dynamics with inertia, wall contacts and sliding; the default) or
             ``unicycle`` (exact arcs, blocked by walls; the thesis's missions).
         max_force: Force limit of the drive joint (N; pymunk dynamics; for the unicycle, the benchmarks'
-            reference loop only).
-        max_torque: Torque limit of its steering joint (N m).
+            reference loop only). Every finite positive value is physical: beyond saturation (the force that
+            reaches any command within a substep, ``2 max_speed * substeps / dt`` for a 1 kg robot with
+            ``robot_radius * max_yaw_rate <= max_speed``) the joints get force and torque scaled by one factor
+            and the force capped by the skin (:func:`digslam.envs.sim.robot.drive_limits`), so a stiff drive
+            rams walls without the premise guard's hard stops.
+        max_torque: Torque limit of its steering joint (N m; every finite positive value, as ``max_force``).
         n_sonars: Number of sonar cones, evenly spread around the heading.
         sonar_gamma: Half-aperture of each cone (rad), in (0, pi].
         sonar_range: Maximum sonar range (m).
