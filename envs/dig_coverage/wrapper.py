@@ -15,15 +15,15 @@ pose box, the dig zone ``M⁻`` and the explored thick set, and the wrapper hand
 
 **Observations from the observer only.** Everything in ``"map"`` and ``"state"`` comes from the filter's
 sets and boxes, the grid and the step count: two worlds that give the same records (and the same start
-box) give the same observations. Ground truth (the true reachable free area, ``truth``) enters only the
-reward, the termination and ``info``. So ``state[9]`` is *not* ``info["certified_coverage"]``: that one is
-a share of the reachable free area, which a real robot does not know and which would tell the agent how
-much is left to find; the state's value grows with the same clear area but over a denominator fixed in
-advance. (It used to be the reachable share, issue #18: the shipped PPO model was trained with that one;
-it still loads and runs, its behaviour may shift.)
+box) give the same observations. Ground truth (the certifiable reachable free area, ``truth``) enters only
+the reward, the termination and ``info``. So ``state[9]`` is *not* ``info["certified_coverage"]``: that one
+is a share of the certifiable reachable free area, which a real robot does not know and which would tell the
+agent how much is left to find; the state's value grows with the same clear area but over a denominator
+fixed in advance.
 
 ``info`` adds the pose box (``pose_box (2, 2)``, ``heading_box (2,)``), ``certified_coverage``
-(clear cells in the reachable free area over that area, :func:`reachable_free`), ``clear_area`` (m²),
+(clear cells in the certifiable reachable free area over that area, :func:`reachable_free`: closed cells
+that meet no obstacle and connect to the start), ``clear_area`` (m²),
 ``true_coverage`` (the ground truth over the same cells: the share of the reachable free cells whose centre
 was truly sensed, so ``certified_coverage <= true_coverage`` at every step, checked by ``monitor=True``)
 and ``consistent`` / ``inconsistent_step``; with ``info_sets=True`` (:class:`.config.ObserverConfig`) also
@@ -113,11 +113,19 @@ def make_grid(cfg: ObserverConfig, world_frame: tuple[float, ...]) -> Grid:
 
 
 def reachable_free(world: World, grid: Grid, start: np.ndarray, sub: int = 4) -> np.ndarray:
-    """``(ny, nx)`` bool: cells entirely free in the exact raster and connected to the start.
+    """``(ny, nx)`` bool, row 0 at the top: the **certifiable reachable free area**, the denominator of the
+    certified and the ground-truth coverage.
+
+    A cell counts when its *closed* box meets no obstacle (``rasterize(..., closed=True)``: a cell that
+    touches a wall only on its boundary, a wall along a cell edge or a vertex on a cell corner, is out) and
+    it is connected to the start. The observer's claims are about closed cells, so a cell that touches an
+    obstacle can never be proved free: counting it would keep certified coverage below 1 by construction.
+    Both coverages count over these cells, so *certified <= ground truth <= 1* holds and 1 is reachable in
+    principle.
 
     Connectivity is taken on a raster ``sub`` times finer (8-connected free fine cells), so passages
-    narrower than an observer cell still connect the free space beyond them; a grid cell counts when it is
-    entirely free and its fine cells belong to the start's component.
+    narrower than an observer cell still connect the free space beyond them; a grid cell counts when its
+    fine cells belong to the start's component.
     """
     x0, y0, x1, _ = grid.lo + grid.hi
     ny, nx = grid.shape
@@ -133,7 +141,7 @@ def reachable_free(world: World, grid: Grid, start: np.ndarray, sub: int = 4) ->
     lab = int(block.max())  # the start cell's component (its free fine cells are connected)
     if not lab:
         return np.zeros(grid.shape, dtype=bool)
-    coarse = rasterize(world.edges, frame, res)[::-1][:ny, :nx] == FREE
+    coarse = rasterize(world.edges, frame, res, closed=True)[::-1][:ny, :nx] == FREE
     inside = (labels == lab).reshape(ny, sub, nx, sub).all(axis=(1, 3))
     return coarse & inside
 

@@ -4,6 +4,12 @@ A cell is MIXED iff some obstacle edge meets its open interior; otherwise the wh
 every edge and its class is that of its centre (even-odd rule). Both steps are vectorised: edges are paired
 with the cells of their bounding box, and centres are classified row by row with crossing toggles
 and a cumsum.
+
+``rasterize(..., closed=True)`` classifies the *closed* cells instead: a cell is MIXED as soon as an edge
+meets its closed box, its boundary included (a wall lying on a cell edge, a vertex on a cell corner), up to
+a relative tolerance of :data:`CLOSED_TOL` cells, so that a wall on a grid line counts on both sides
+whatever the rounding of the cell bounds. A FREE cell of that raster is free with its boundary: the cells
+that a sound observer, whose claims are about closed cells, can prove free.
 """
 
 from __future__ import annotations
@@ -11,6 +17,9 @@ from __future__ import annotations
 import numpy as np
 
 FREE, OCCUPIED, MIXED = 0, 1, 2
+#: Slack of the closed-cell test (``rasterize(..., closed=True)``), in cells: an edge within this share of a
+#: cell of the closed box counts as meeting it.
+CLOSED_TOL = 1e-9
 
 
 def grid_shape(frame: tuple[float, float, float, float], resolution: float) -> tuple[int, int]:
@@ -38,14 +47,24 @@ def _centre_free(edges: np.ndarray, x0: float, y0: float, res: float, ny: int, n
     return (np.cumsum(acc, axis=1)[:, :nx] % 2) == 1
 
 
-def _mixed(edges: np.ndarray, x0: float, y0: float, res: float, ny: int, nx: int) -> np.ndarray:
+def _mixed(edges: np.ndarray, x0: float, y0: float, res: float, ny: int, nx: int,
+           closed: bool = False) -> np.ndarray:  # fmt: skip
     out = np.zeros((ny, nx), dtype=bool)
     if len(edges) == 0:
         return out
-    lo_x = np.clip(np.floor((np.minimum(edges[:, 0], edges[:, 2]) - x0) / res), 0, nx - 1).astype(np.int64)
-    hi_x = np.clip(np.floor((np.maximum(edges[:, 0], edges[:, 2]) - x0) / res), 0, nx - 1).astype(np.int64)
-    lo_y = np.clip(np.floor((np.minimum(edges[:, 1], edges[:, 3]) - y0) / res), 0, ny - 1).astype(np.int64)
-    hi_y = np.clip(np.floor((np.maximum(edges[:, 1], edges[:, 3]) - y0) / res), 0, ny - 1).astype(np.int64)
+    grow = 1 if closed else 0  # a closed cell also meets the edges on its boundary: look one cell further
+    lo_x = np.clip(np.floor((np.minimum(edges[:, 0], edges[:, 2]) - x0) / res) - grow, 0, nx - 1).astype(
+        np.int64
+    )
+    hi_x = np.clip(np.floor((np.maximum(edges[:, 0], edges[:, 2]) - x0) / res) + grow, 0, nx - 1).astype(
+        np.int64
+    )
+    lo_y = np.clip(np.floor((np.minimum(edges[:, 1], edges[:, 3]) - y0) / res) - grow, 0, ny - 1).astype(
+        np.int64
+    )
+    hi_y = np.clip(np.floor((np.maximum(edges[:, 1], edges[:, 3]) - y0) / res) + grow, 0, ny - 1).astype(
+        np.int64
+    )
     wx, wy = hi_x - lo_x + 1, hi_y - lo_y + 1
     counts = wx * wy
     e = np.repeat(np.arange(len(edges)), counts)
@@ -57,27 +76,31 @@ def _mixed(edges: np.ndarray, x0: float, y0: float, res: float, ny: int, nx: int
     L = np.zeros(len(e))
     U = np.ones(len(e))
     ok = np.ones(len(e), dtype=bool)
-    for p, d, lo_b in ((px, dx, x0 + ix * res), (py, dy, y0 + iy * res)):
-        hi_b = lo_b + res
+    slack = CLOSED_TOL * res if closed else 0.0
+    for p, d, lo_c in ((px, dx, x0 + ix * res), (py, dy, y0 + iy * res)):
+        lo_b, hi_b = lo_c - slack, lo_c + res + slack
         flat = d == 0
-        ok &= ~flat | ((lo_b < p) & (p < hi_b))
+        ok &= ~flat | (((lo_b <= p) & (p <= hi_b)) if closed else ((lo_b < p) & (p < hi_b)))
         with np.errstate(divide="ignore", invalid="ignore"):
             ta, tb = (lo_b - p) / d, (hi_b - p) / d
         L = np.where(flat, L, np.maximum(L, np.minimum(ta, tb)))
         U = np.where(flat, U, np.minimum(U, np.maximum(ta, tb)))
     # Open slabs: the t-set is (L', U') intersected with [0, 1]; strictness matters only for the slab ends.
-    hit = ok & (L < U)
+    # Closed slabs (``closed``): [L', U'], so an edge that only touches the cell's boundary meets it.
+    hit = ok & ((L <= U) if closed else (L < U))
     out[iy[hit], ix[hit]] = True
     return out
 
 
-def rasterize(edges: np.ndarray, frame: tuple[float, float, float, float], resolution: float) -> np.ndarray:
+def rasterize(edges: np.ndarray, frame: tuple[float, float, float, float], resolution: float,
+              closed: bool = False) -> np.ndarray:  # fmt: skip
     """Classify the cells of ``frame`` as FREE (0), OCCUPIED (1) or MIXED (2).
 
     Args:
         edges: Obstacle edges ``(E, 4)`` (even-odd convention: free where the crossing count is odd).
         frame: ``(xmin, ymin, xmax, ymax)``; cell ``[i, j]`` spans ``x0 + j*res`` .. and ``y0 + i*res`` ..
         resolution: Cell size.
+        closed: Classify closed cells: an edge on a cell's boundary makes it MIXED (see the module).
 
     Returns:
         ``int8`` array ``(ny, nx)``, row index along y.
@@ -85,7 +108,7 @@ def rasterize(edges: np.ndarray, frame: tuple[float, float, float, float], resol
     ny, nx = grid_shape(frame, resolution)
     x0, y0 = float(frame[0]), float(frame[1])
     free = _centre_free(edges, x0, y0, resolution, ny, nx)
-    mixed = _mixed(edges, x0, y0, resolution, ny, nx)
+    mixed = _mixed(edges, x0, y0, resolution, ny, nx, closed)
     return np.where(mixed, MIXED, np.where(free, FREE, OCCUPIED)).astype(np.int8)
 
 
@@ -98,6 +121,7 @@ def cell_centres(
 
 
 __all__ = [
+    "CLOSED_TOL",
     "cell_centres",
     "grid_shape",
     "rasterize",
