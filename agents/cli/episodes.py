@@ -135,8 +135,8 @@ def cmd_replay(args: argparse.Namespace) -> int:
             inside = bool(np.all(res.tube.contains(ep.records.t, ep.truth.pose[:, :2])))
             dr = res.dead_reckoning
             dr_txt = f"{float(np.max(dr)):.3f}" if dr is not None else "n/a"
-            print(f"dig_slam: {res.iterations} iterations; tube width max {float(np.max(w)):.3f} m, "
-                  f"final {float(np.ravel(w)[-1]):.3f} m (dead reckoning max {dr_txt} m); "
+            print(f"dig_slam: {res.iterations} iterations; pose box widest {float(np.max(w)):.3f} m, "
+                  f"final {float(np.ravel(w)[-1]):.3f} m (dead reckoning widest {dr_txt} m); "
                   f"truth inside the tube: {inside}")  # fmt: skip
     return 0 if ok else 1
 

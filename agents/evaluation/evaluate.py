@@ -85,7 +85,11 @@ class EvalResult:
         curves reach (the last step if none does), ground-truth coverage at the last of them, collisions and
         final tube width."""
         steps = [int(s) for s in at if 0 <= int(s) <= self.n_steps] or [self.n_steps]
-        head = [f"certified @ {s}" for s in steps] + [f"true @ {steps[-1]}", "collisions", "final tube (m)"]
+        head = [f"certified @ {s}" for s in steps] + [
+            f"true @ {steps[-1]}",
+            "collisions",
+            "final pose box (m)",
+        ]
         lines = ["| agent | " + " | ".join(head) + " |", "|---" * (len(head) + 1) + "|"]
 
         def ms(x: np.ndarray, fmt: str) -> str:
@@ -275,7 +279,8 @@ def coverage_figure(result: EvalResult, path: str | Path, target: float | None =
     ax.set_xlabel("steps")
     ax.set_ylabel("share of the reachable free area")
     ax.set_ylim(0, 1)
-    ax.set_xlim(0, max(result.n_steps, 1))
+    ran = [int(v.max()) for v in result.lengths.values() if np.size(v)]
+    ax.set_xlim(0, max(max(ran) if ran else result.n_steps, 1))  # to the last step any episode ran
     n = next(iter(result.curves.values())).shape[0] if result.curves else 0
     over = "1 episode" if n == 1 else f"mean ± std over {n} episodes (one per map)"
     ax.set_title(f"{result.env_id or 'coverage'}: coverage of the reachable free area, {over}", fontsize=9)
