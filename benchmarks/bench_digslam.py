@@ -5,7 +5,8 @@ The thesis's room of Fig. 6.10, a 20-minute loop sampled every 0.1 s (12,001 sam
 reports 4 iterations in under 40 s (its predecessor, Jaulin 2011: about 90 s). There is no peer library to
 run: the figures are ours, the thesis's are quoted.
 
-Usage: ``python benchmarks/bench_digslam.py [--duration S] [--repeats R]``. The last line is
+Usage: ``python benchmarks/bench_digslam.py [--duration S] [--repeats R] [--quick]`` (``--quick``: a 60 s
+mission, timed once). The last line is
 ``seconds=<median time of dig_slam>`` (mission generation excluded).
 """
 
@@ -26,7 +27,10 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--duration", type=float, default=1200.0)
     p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--quick", action="store_true", help="a smoke run: a 60 s mission, timed once")
     a = p.parse_args()
+    if a.quick:
+        a.duration, a.repeats = 60.0, 1
     world = ThesisRoom().generate(0)
     record, truth = loop_mission(world, duration=a.duration, seed=0)
     grid = Grid.from_cell_size((-10.0, -10.0), (10.0, 10.0), 0.05)

@@ -12,7 +12,8 @@ too. The same env with the exact unicycle dynamics (``dynamics="unicycle"``) is 
 ending in ``_unicycle``). All are timed warm (one untimed run of each first, which also loads the compiled
 kernels), the repeats alternating between them.
 
-Usage: ``python benchmarks/bench_env.py [--steps N] [--repeats R]``. The last line is
+Usage: ``python benchmarks/bench_env.py [--steps N] [--repeats R] [--quick]`` (``--quick``: 100 steps, one
+repeat). The last line is
 ``ratio_vs_raycast=<ours / reference>`` (median of the repeats, wall-clock time).
 """
 
@@ -115,7 +116,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--steps", type=int, default=2000)
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--quick", action="store_true", help="a smoke run: 100 steps, one repeat")
     args = parser.parse_args()
+    if args.quick:
+        args.steps, args.repeats = 100, 1
     env, uni = make_ours(), make_ours("unicycle")
     rng = np.random.default_rng(0)
     actions = np.column_stack([rng.uniform(0.3, 1.0, args.steps), rng.uniform(-1, 1, args.steps)])

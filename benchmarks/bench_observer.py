@@ -23,8 +23,9 @@ The envs move the robot with pymunk, the default dynamics (the record then bound
 and the filter's tube grows with it). The same pair (raw, observed at ``q = 0``) with the exact unicycle
 dynamics runs afterwards on the same actions and seeds; its figures end in ``_unicycle``.
 
-Usage: ``python benchmarks/bench_observer.py [--steps N] [--episode K] [--chunk C] [--grid-cell S]``
-(``S``: the observer's cell side, m; 0.078125 for the grid twice as fine). Last line:
+Usage: ``python benchmarks/bench_observer.py [--steps N] [--episode K] [--chunk C] [--grid-cell S] [--quick]``
+(``S``: the observer's cell side, m; 0.078125 for the grid twice as fine; ``--quick``: 200 steps in episodes of
+100, a smoke run). Last line:
 ``observer_overhead=<raw steps per second / observed steps per second>`` (``q = 0``).
 """
 
@@ -89,7 +90,10 @@ def main() -> None:
     parser.add_argument(
         "--grid-cell", type=float, default=None, help="observer cell side (m); default: the env's"
     )
+    parser.add_argument("--quick", action="store_true", help="a smoke run: 200 steps, episodes of 100")
     args = parser.parse_args()
+    if args.quick:
+        args.steps, args.episode, args.chunk = 200, 100, 50
     rng = np.random.default_rng(0)
     actions = np.column_stack([rng.uniform(0.2, 1.0, args.steps), rng.uniform(-1, 1, args.steps)])
     actions = actions.astype(np.float32)

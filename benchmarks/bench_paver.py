@@ -4,7 +4,7 @@ codac runs in a subprocess (importing it switches this process to upward roundin
 ``ratio_vs_codac=<our time / codac time>``, the worst case over the runs. Both cut boxes at 0.49 of their
 largest side (codac's default; ``--ratio 0.5`` for the thesis's midpoint), so the pavings are comparable
 box for box: the ring's are identical. ``--kappa K`` paves ours with ``cut="grid", max_volume=K ε²``
-instead (see :func:`pave`).
+instead (see :func:`pave`). ``--quick``: ε = 0.05 only, one repeat (a smoke run).
 """
 
 from __future__ import annotations
@@ -54,7 +54,10 @@ def main() -> None:
         help="bisection ratio (default 0.49, codac's own cut, so both pavers build the same tree)",
     )
     ap.add_argument("--kappa", type=float, default=None, help="ours with cut='grid', max_volume=kappa*eps**2")
+    ap.add_argument("--quick", action="store_true", help="a smoke run: eps 0.05 only, one repeat")
     args = ap.parse_args()
+    if args.quick:
+        args.eps, args.repeat = [0.05], 1
     worst = 0.0
     print(f"{'problem':8} {'eps':>6} | {'ours s':>8} {'boxes':>7} {'undet.':>9} | "
           f"{'codac s':>8} {'boxes':>7} {'undet.':>9} | ratio")  # fmt: skip

@@ -10,6 +10,7 @@ Landmark at the origin, frame ``[-6, 4]²``, range ``[4, 6]``, bearing ``[-π/12
 
 Prints time, bisections and undetermined area for each, then ours against codac's fewest bisections.
 The last line is ``ratio_vs_codac=<our polar time / fastest codac time>``, the worst case over the ε.
+``--quick``: ε = 0.05 only, one repeat (a smoke run).
 """
 
 from __future__ import annotations
@@ -47,7 +48,10 @@ def main() -> None:
     ap.add_argument("--eps", type=float, nargs="+", default=[0.01, 0.001])
     ap.add_argument("--repeat", type=int, default=2, help="best of N for ours")
     ap.add_argument("--kappa", type=float, default=0.5, help="grid cut with max_volume = kappa * eps**2")
+    ap.add_argument("--quick", action="store_true", help="a smoke run: eps 0.05 only, one repeat")
     args = ap.parse_args()
+    if args.quick:
+        args.eps, args.repeat = [0.05], 1
     worst, summary = 0.0, []
     print(f"{'eps':>6} {'method':30} {'seconds':>8} {'bisections':>10} {'undetermined':>12} {'inner':>9}")
     for eps in args.eps:

@@ -13,6 +13,8 @@ curve, collision count, tube width, length and path length).
 Last line: ``speedup=<sequential time / Ray time>`` (goal >= 1.6 with 2 workers on 2 cores).
 
     python benchmarks/bench_sweep.py [--maps 30] [--steps 3000] [--generators room rocks caves rooms] [--workers 2]
+
+``--quick``: one map of room and of rocks, 200 steps (a smoke run; Ray's start-up dominates it).
 """
 
 from __future__ import annotations
@@ -51,13 +53,19 @@ def main() -> None:
         "--generators", nargs="+", default=list(GENERATORS), help="suite generators (default all)"
     )
     ap.add_argument("--workers", type=int, default=2, help="CPUs of the local Ray instance (one actor each)")
+    ap.add_argument("--quick", action="store_true", help="a smoke run: 1 map of room and rocks, 200 steps")
     args = ap.parse_args()
+    if args.quick:
+        args.maps, args.steps, args.generators = 1, 200, ["room", "rocks"]
     gens, total = args.generators, len(args.generators) * args.maps * args.steps
     print(f"workload: {args.agent} on {len(gens)} generators ({', '.join(gens)}) x {args.maps} test maps x "
           f"{args.steps} steps = {total} env steps, target 1.0; load average {os.getloadavg()[0]:.2f} "
           f"on {os.cpu_count()} cores")  # fmt: skip
 
-    import ray
+    try:
+        import ray
+    except ImportError:
+        raise SystemExit("bench_sweep: needs Ray (pip install 'digslam[ray]')") from None
 
     t0 = time.perf_counter()
     policy = build_policy(args.agent, ENV, None, seed=0)

@@ -5,7 +5,7 @@ Ours: :func:`digslam.observer.thick.sivia.thick_sivia` with the closed-form thic
 cannot be installed here, so its figures are the reference ones measured on this machine:
 0.034 s / 9,543 bisections at ε = 0.01 and 0.279 s / 76,521 bisections at ε = 0.001. The times are
 medians of ``--repeat`` runs (wall clock; the CPU time is printed too, the machine being shared). The last line is ``ratio_vs_codac1=<our time / 0.279>`` at ε = 0.001
-(goal: ≤ 0.2 with at most 76,521 bisections).
+(goal: ≤ 0.2 with at most 76,521 bisections). ``--quick``: one run per ε (a smoke run).
 """
 
 from __future__ import annotations
@@ -40,7 +40,10 @@ def ours(eps: float, repeat: int) -> tuple[float, float, int]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=7, help="median of N runs")
+    ap.add_argument("--quick", action="store_true", help="a smoke run: one run per eps")
     args = ap.parse_args()
+    if args.quick:
+        args.repeat = 1
     ours(0.01, 1)  # warm-up (imports, caches)
     print(
         f"{'eps':>6} | {'ours s':>8} {'cpu s':>8} {'bisect.':>8} | {'codac1 s':>8} {'bisect.':>8} | "

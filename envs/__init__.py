@@ -80,7 +80,7 @@ COVERAGE_IDS: dict[str, dict[str, object]] = {
 
 for _ids, _entry in (
     (ENV_IDS, "digslam.envs.explore.env:ExploreEnv"),
-    (COVERAGE_IDS, "digslam.envs.dig_coverage.env:DigCoverageEnv"),
+    (COVERAGE_IDS, "digslam.envs.dig_coverage.env:DigCoverageEnv"),  # it holds the id's spec
 ):
     for _id, _kw in _ids.items():
         if _id not in gym.registry:

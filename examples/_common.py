@@ -6,7 +6,8 @@
 * :func:`report` prints a result dict as ``key: value`` lines.
 
 A script run as ``python examples/<name>.py`` has this folder on ``sys.path``, so ``from _common import
-...`` works; ``tests/example_loader.py`` puts it there before importing a script by path.
+...`` works; ``tests/example_loader.py`` and ``benchmarks/bench_localization.py`` put it there before
+importing a script by path.
 """
 
 from __future__ import annotations

@@ -6,6 +6,16 @@ Lives here: :mod:`.config` (``ObserverConfig``, ``DigCoverageConfig``), :mod:`.w
 :mod:`.maps_jit` (the observation maps' kernels), :mod:`.monitor` (``GuaranteeMonitor``, checks every claim
 against the truth) and :mod:`.env` (``DigCoverageEnv``, reward and ``RGB`` palette).
 
+The ids are registered by :mod:`digslam.envs` with :class:`DigCoverageEnv` as their entry point: the env an
+id makes holds the id's spec (``env.spec``) and renders ``rgb_array``
+only; ``env.unwrapped`` is the raw :class:`~digslam.envs.explore.env.ExploreEnv` underneath, whose spec is
+its own (``digslam/Explore-v0`` with its config) and which passes ``gymnasium``'s ``check_env`` by itself.
+
+Training with stable-baselines3 on a small machine: use one torch thread per process
+(``torch.set_num_threads(1)``, and ``OMP_NUM_THREADS=1`` for the workers of a ``SubprocVecEnv``): the
+policy's tensors are small, and more threads than cores only contend with the env processes (``digslam
+train`` pins one thread already).
+
 May import: all of :mod:`digslam.observer`, :mod:`digslam.envs.explore` and below; gymnasium, numpy.
 """
 

@@ -75,6 +75,8 @@ class DigCoverageEnv(GuaranteedObserver):
         cfg = DigCoverageConfig.split({**base, **kwargs})
         self.config = cfg
         super().__init__(ExploreEnv(cfg.explore), config=cfg.observer)
+        self._id_spec: Any = None
+        self.env.unwrapped.built_inside(self)  # the id's spec is this env's; the raw env keeps its own
         self.metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
         self._render_mode = render_mode
         self._bg: np.ndarray | None = None
@@ -84,6 +86,16 @@ class DigCoverageEnv(GuaranteedObserver):
     @property
     def render_mode(self) -> str | None:  # type: ignore[override]
         return self._render_mode
+
+    @property
+    def spec(self) -> Any:  # type: ignore[override]
+        """The spec of the id that made this env (``gym.make`` writes it onto ``env.unwrapped``, which passes
+        it here), else the wrapper's own."""
+        return self._id_spec if self._id_spec is not None else super().spec
+
+    @spec.setter
+    def spec(self, value: Any) -> None:
+        self._id_spec = value
 
     def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         obs, _, _, truncated, info = super().step(action)

@@ -43,6 +43,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
+from gymnasium.envs.registration import EnvSpec
 
 from digslam.envs.config import ExploreConfig
 from digslam.envs.explore.coverage import Coverage
@@ -82,6 +83,35 @@ class ExploreEnv(gym.Env):
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
+    _spec: EnvSpec | None = None
+    _spec_owner: Any = None  # the env an id builds around this raw env (:meth:`built_inside`)
+
+    @property
+    def spec(self) -> EnvSpec | None:  # type: ignore[override]
+        """This raw env's own spec: that of ``gym.make`` for the ``Explore`` ids, None when built directly;
+        inside an env that an id makes around it (:meth:`built_inside`), ``digslam/Explore-v0`` with this
+        env's config, never the outer id (the outer env holds that)."""
+        return self._spec
+
+    @spec.setter
+    def spec(self, value: EnvSpec | None) -> None:
+        # ``gym.make`` writes the spec of the id it made onto ``env.unwrapped``, this raw env; when that id
+        # made the env around it, the spec is the outer env's
+        if self._spec_owner is not None:
+            self._spec_owner.spec = value
+        else:
+            self._spec = value
+
+    def built_inside(self, owner: Any) -> None:
+        """Make this raw env the base of ``owner`` (an env with a settable ``spec``: the
+        ``digslam/DigCoverage-*`` ids' :class:`~digslam.envs.dig_coverage.env.DigCoverageEnv`): its spec
+        becomes ``digslam/Explore-v0`` with its own config (so ``spec.make()`` builds an equal raw env, in
+        any of its render modes), and the id's spec that ``gym.make`` then writes onto ``owner.unwrapped``
+        goes to ``owner``."""
+        self._spec = EnvSpec(id="digslam/Explore-v0", entry_point="digslam.envs.explore.env:ExploreEnv",
+                             kwargs={"config": self.config.to_dict()}, max_episode_steps=None,
+                             order_enforce=False, disable_env_checker=True)  # fmt: skip
+        self._spec_owner = owner
 
     def __init__(
         self,
@@ -156,9 +186,8 @@ class ExploreEnv(gym.Env):
                 pose = self.world.sample_free_pose(self.np_random, 1.5 * cfg.robot_radius + skin)
         else:
             pose = self.world.sample_reachable_pose(self.np_random, 1.5 * cfg.robot_radius + skin)
-        self.sim = RobotSim(
-            self.world, cfg.robot_radius, pose, cfg.max_force, cfg.max_torque, skin, cfg.dynamics
-        )
+        self.sim = RobotSim(self.world, cfg.robot_radius, pose, cfg.max_force, cfg.max_torque, skin,
+                            cfg.dynamics, max_speed=cfg.max_speed, max_yaw_rate=cfg.max_yaw_rate)  # fmt: skip
         self.coverage = Coverage(self.world, cfg.coverage_resolution, float(self.suite.r_max.max()))
         self.t, self.path = 0.0, [pose[:2].copy()]
         record, truth = self._sense(0)

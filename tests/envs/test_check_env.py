@@ -1,8 +1,8 @@
 """Every registered environment keeps the Gymnasium contract, wrapped (``gym.make``) and unwrapped.
 
 The certified-coverage environments wrap the raw exploration env; its own ``step`` must return a real
-observation (the observer's skipping of it is an internal fast path), so ``check_env(env.unwrapped)``
-passes too.
+observation (the observer's skipping of it is an internal fast path), and its spec and render modes are its
+own (not the DigCoverage id's), so ``check_env(env.unwrapped)`` passes too, render checks included.
 """
 
 from __future__ import annotations
@@ -26,17 +26,74 @@ def test_every_id_is_checked() -> None:
     assert set(IDS) == ours == set(digslam.envs.ENV_IDS) | set(digslam.envs.COVERAGE_IDS)
 
 
+def _make(env_id: str, **kw: object) -> gym.Env:
+    return gym.make(env_id, **({"map_size": 36} if env_id in digslam.envs.COVERAGE_IDS else {}), **kw)
+
+
 @pytest.mark.parametrize("env_id", IDS)
-def test_check_env_wrapped_and_unwrapped(env_id: str) -> None:
-    kw = {"map_size": 36} if env_id in digslam.envs.COVERAGE_IDS else {}
-    env = gym.make(env_id, **kw)
+def test_check_env_wrapped_and_unwrapped(env_id: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The whole checker, render modes included (each mode of ``metadata`` made from the env's spec and
+    rendered; ``human`` headless)."""
+    monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")
+    env = _make(env_id)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # check_env notes that gym.make's env is wrapped
-            check_env(env, skip_render_check=True)
-        check_env(env.unwrapped, skip_render_check=True)
+            check_env(env)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # the raw env: no note at all (it has a spec of its own)
+            check_env(env.unwrapped)
     finally:
         env.close()
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_spec_and_metadata_say_what_each_layer_is(env_id: str) -> None:
+    """``env.spec`` is the id's; a DigCoverage env's ``env.unwrapped`` is the raw exploration env, with a
+    spec of its own (``digslam/Explore-v0`` and its config: ``spec.make()`` builds an equal raw env, with
+    no wrappers) and the render modes of the raw env; the DigCoverage env itself renders ``rgb_array``."""
+    env = _make(env_id)
+    raw = env.unwrapped
+    try:
+        assert env.spec is not None and env.spec.id == env_id and env.spec.max_episode_steps == 1000
+        assert isinstance(raw, digslam.envs.ExploreEnv) and raw.spec is not None
+        assert raw.metadata["render_modes"] == ["rgb_array", "human"]
+        if env_id in digslam.envs.ENV_IDS:
+            assert raw.spec.id == env_id
+            return
+        assert raw.spec.id == "digslam/Explore-v0" and env.spec.additional_wrappers == ()
+        assert env.metadata["render_modes"] == ["rgb_array"]
+        again = raw.spec.make()
+        try:
+            assert type(again) is digslam.envs.ExploreEnv and again.config == raw.config
+            assert again.spec is not None and again.spec.id == "digslam/Explore-v0"
+        finally:
+            again.close()
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_seeded_rollouts_repeat(env_id: str) -> None:
+    """Two envs of one id, reset with one seed and given the same actions, return the same observations,
+    rewards and ends."""
+    actions = np.random.default_rng(7).uniform([0.2, -1.0], [1.0, 1.0], (25, 2)).astype(np.float32)
+    runs = []
+    for _ in range(2):
+        env = _make(env_id)
+        try:
+            obs, _ = env.reset(seed=11)
+            steps = [(obs, 0.0, False, False)]
+            for a in actions:
+                obs, reward, terminated, truncated, _ = env.step(a)
+                steps.append((obs, reward, terminated, truncated))
+        finally:
+            env.close()
+        runs.append(steps)
+    for (oa, ra, ta, ua), (ob, rb, tb, ub) in zip(*runs, strict=True):
+        assert oa.keys() == ob.keys() and (ra, ta, ua) == (rb, tb, ub)
+        for k in oa:
+            np.testing.assert_array_equal(oa[k], ob[k], err_msg=k)
 
 
 @pytest.mark.parametrize("env_id", sorted(digslam.envs.COVERAGE_IDS))
