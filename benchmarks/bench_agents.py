@@ -6,32 +6,41 @@ row ``ppo_lowlevel``, when they exist, each on the env keywords of its ``.json``
 observation, not the levels) runs on the same ``--maps`` levels of each generator of
 :data:`digslam.agents.evaluation.suite.GENERATORS` (room, rocks, caves, rooms): the first seeds of the test
 split (``digslam.envs.splits``), ``target=1.0`` (no early end), ``--steps`` steps
-(:func:`digslam.agents.evaluation.suite.run_suite`). Prints the leaderboard (T90 per generator with its
-success rate, T90 / AUC / final tube over all maps, and the ratio to the best baseline with its paired
-bootstrap 95 % interval), writes ``leaderboard.md``, ``leaderboard.png``, ``suite.json`` and ``best.json``
-(the best agent overall, learned ones included; copied to ``agents/data/leaderboard.json`` it becomes
-``digslam demo``'s default agent) to ``--out``,
-then prints ``heuristic_t90_success=<share of the test maps, over all generators, on which the best
-baseline reaches 0.9 certified coverage>`` and ``eval_steps_per_s=<observed env steps per second with the
-frontier agent, one process>``; with a learned model it ends with ``speedup_t95=`` and
-``speedup_t90=<geometric mean over the test maps of all generators of T90(best baseline) / T90(learned)>``
-[paired bootstrap 95 % interval], each after its per-generator values. ``--model`` takes any model of
-``digslam train``, a goal-selection MaskablePPO model included.
+(:func:`digslam.agents.evaluation.suite.run_suite`). The headline is ``T_level``, the steps to each
+generator's target level (:data:`digslam.agents.evaluation.levels.TARGET_LEVELS`, fixed on the validation
+split by ``bench_levels.py``). Prints the leaderboard (``T_level`` per generator with its success rate,
+``T_level`` / T90 / AUC / final pose box over all maps, and the geometric-mean speedup over the best
+baseline with its paired bootstrap 95 % interval), writes ``leaderboard.md``, ``leaderboard.png``,
+``suite.json`` and ``best.json`` (the best agent overall, learned ones included; copied to
+``agents/data/leaderboard.json`` it becomes ``digslam demo``'s default agent) to ``--out``, and ends with:
+
+* ``target_levels=room:…,rocks:…,caves:…,rooms:…``;
+* ``best_heuristic_<generator>=`` (the baseline of smallest mean ``T_level`` there) and ``best_heuristic=``
+  (over all maps);
+* ``heuristic_level_success=<share of the test maps, over all generators, on which the best heuristic
+  reaches its generator's level>``;
+* ``eval_steps_per_s=<observed env steps per second with the frontier agent, one process>`` and
+  ``eval_over_observed=<that over the observed env's steps per second without an agent, a fixed action,
+  measured in the same process>``;
+* with a learned model: ``speedup_<generator>=`` and ``speedup=<geometric mean over the test maps of all
+  generators of T_level(best heuristic) / T_level(learned)> [paired bootstrap 95 % interval]``.
+
+``--model`` takes any model of ``digslam train``, a goal-selection MaskablePPO model included.
 
 Usage: ``python benchmarks/bench_agents.py [--quick] [--maps 30] [--steps 3000] [--out DIR] [--model PATH]
-[--set KEY=VALUE ...] [--generators G ...] [--agents A ...] [--ray [--address A] [--workers N]]`` (also
-``digslam benchmark agents ...``). ``--set`` gives every agent and generator an environment keyword (``--set
-grid_cell=0.078125``: the observer on a grid twice as fine; ``--set 'noise={speed=0.0, yaw_rate=0.0}'``:
-exact odometry, the certified ceiling of a planner when the pose box does not drift); ``--generators`` runs
-some generators only; ``--agents`` some agents only (``--agents frontier``: the reference baseline alone,
-about 6 minutes for the full suite on a 2-core machine; the best baseline and ``heuristic_t90_success`` are then those of the agents
-run).
-The full suite (4 generators x 30 maps x 3000 steps x 5 agents, about 1.8 M steps) takes roughly half an
-hour on one core (the frontier
-agent's 360 000 steps take about 135 s; the PPO policy is slower); ``--quick`` (3 maps,
-300 steps) a minute. ``--ray`` runs the same suite on a pool of Ray actors
-(:func:`digslam.agents.evaluation.ray_eval.run_suite_ray`; a local instance with ``--workers`` CPUs, or the
-cluster at ``--address``) with identical results; ``eval_steps_per_s`` is still measured in this process.
+[--set KEY=VALUE ...] [--generators G ...] [--agents A ...] [--from F ...] [--ray [--address A]
+[--workers N]]`` (also ``digslam benchmark agents ...``). ``--set`` gives every agent and generator an
+environment keyword (``--set grid_cell=0.078125``: the observer on a grid twice as fine; ``--set
+'noise={speed=0.0, yaw_rate=0.0}'``: exact odometry, the certified ceiling of a planner when the pose box
+does not drift); ``--generators`` runs some generators only; ``--agents`` some agents only (``--agents
+frontier``: the reference baseline alone; the best baseline and ``heuristic_level_success`` are then those
+of the agents run); ``--from`` reads the suite JSONs of earlier runs on the same levels (for example one run
+per agent, in parallel processes) and merges them instead of running (the speed figures are still measured
+here). The full suite (4 generators x 30 maps x 3000 steps x 8 agents, about 2.9 M steps) takes about an
+hour on one core; ``--quick`` (3 maps, 300 steps) a minute. ``--ray`` runs the same suite on a pool of Ray
+actors (:func:`digslam.agents.evaluation.ray_eval.run_suite_ray`; a local instance with ``--workers`` CPUs,
+or the cluster at ``--address``) with identical results; the speed figures are still measured in this
+process.
 """
 
 from __future__ import annotations
@@ -46,9 +55,10 @@ import gymnasium as gym
 
 import digslam.envs  # noqa: F401  (registers the environments)
 from digslam.agents.baselines.registry import BASELINES, make_baseline
+from digslam.agents.evaluation.levels import TARGET_LEVELS, format_levels
 from digslam.agents.evaluation.metrics import paired_bootstrap_geomean
 from digslam.agents.evaluation.ray_eval import run_suite_ray
-from digslam.agents.evaluation.suite import check_generators, run_suite, steps_per_second
+from digslam.agents.evaluation.suite import SuiteResult, check_generators, merge, run_suite, steps_per_second
 from digslam.agents.learning.models import leaderboard_record
 
 ENV_ID = "digslam/DigCoverage-v0"
@@ -136,6 +146,8 @@ def main() -> None:
                          "(repeatable; values parsed as TOML literals)")  # fmt: skip
     ap.add_argument("--generators", nargs="+", default=None, metavar="G",
                     help="run these generators only (default: room rocks caves rooms)")  # fmt: skip
+    ap.add_argument("--from", dest="sources", nargs="+", type=Path, default=None, metavar="F",
+                    help="suite JSONs of earlier runs on the same levels to merge instead of running")  # fmt: skip
     ap.add_argument("--agents", nargs="+", default=None, metavar="A",
                     help="run these agents only: baselines, ppo and/or ppo_lowlevel (default: all of them); "
                          "the frontier agent always runs, since eval_steps_per_s measures it")  # fmt: skip
@@ -147,6 +159,10 @@ def main() -> None:
         gym.make(ENV_ID, **common).close()  # an unknown key or a bad value: one line, before any episode
         check_generators(args.generators)
         baselines = chosen_baselines(args.agents)
+        missing = [str(p) for p in args.sources or [] if not p.is_file()]
+        if missing:
+            raise ValueError(f"--from: no such file {missing[0]}")
+        loaded = merge([SuiteResult.from_json(p) for p in args.sources]) if args.sources else None
     except ValueError as exc:
         ap.error(str(exc).splitlines()[0])
     maps, steps = (3, 300) if args.quick else (args.maps, args.steps)
@@ -155,6 +171,9 @@ def main() -> None:
     policies: dict[str, Any] = {name: make_baseline(name, env, seed=0) for name in names}
     env.close()
     extra = {name: dict(common) for name in names}
+    if loaded is not None:  # the rows of the runs read: their baselines and learned agents
+        baselines = [a for a in BASELINES if a in loaded.agents]
+        args.agents = [a for a in loaded.agents if a in BASELINES or a in LEARNED]
     ppo = load_ppo(args.model) if args.agents is None or "ppo" in args.agents else None
     if ppo is not None:
         policies["ppo"], extra["ppo"] = ppo, {**model_kwargs(args.model), **common}
@@ -168,7 +187,10 @@ def main() -> None:
     if common:
         print(f"environment keywords of every agent: {common}")
     t0 = time.perf_counter()
-    if args.ray:  # the same policies as specs: baselines sized from ENV_ID with seed 0, the PPO .zip
+    if loaded is not None:
+        res = loaded
+        maps, steps = len(res.seeds), res.steps
+    elif args.ray:  # the same policies as specs: baselines sized from ENV_ID with seed 0, the PPO .zip
         specs = {name: name for name in baselines} | ({"ppo": str(args.model)} if ppo is not None else {})
         specs |= {"ppo_lowlevel": str(args.lowlevel)} if low is not None else {}
         extra = {name: dict(common) for name in baselines} | extra
@@ -188,30 +210,37 @@ def main() -> None:
     print(f"wrote {args.out / 'leaderboard.md'}, {res.figure(args.out / 'leaderboard.png')} and "
           f"{res.to_json(args.out / 'suite.json')}")  # fmt: skip
     best = res.best(baselines + [a for a in LEARNED if a in res.agents])
-    record = leaderboard_record(best, float(res.t90()[best].mean()), maps, steps, list(res.results))
+    record = leaderboard_record(best, float(res.times()[best].mean()), maps, steps, list(res.results),
+                                {g: TARGET_LEVELS.get(g, 0.9) for g in res.results})  # fmt: skip
     text = json.dumps(record, indent=2) + "\n"
     (args.out / "best.json").write_text(text)  # shipped as agents/data/leaderboard.json (models.LEADERBOARD)
     print(f"wrote {args.out / 'best.json'} (best agent overall: {best})")
     best = res.best(baselines)
+    for g in res.results:
+        print(f"best_heuristic_{g}={res.best(baselines, generator=g)}")
     rate = steps_per_second(policies["frontier"], ENV_ID, steps=min(2000, 10 * steps), env_kwargs=common)
-    print(f"best_baseline={best}")
-    print(f"heuristic_t90_success={res.success(best):.4f}")
+    alone = steps_per_second(None, ENV_ID, steps=min(2000, 10 * steps), env_kwargs=common)
+    levels = {g: TARGET_LEVELS.get(g, 0.9) for g in res.results}
+    print(f"target_levels={format_levels(levels)}")
+    print(f"best_heuristic={best}")
+    print(f"heuristic_level_success={res.success(best):.4f}")
     print(f"eval_steps_per_s={rate:.0f}")
+    print(f"eval_over_observed={rate / alone:.3f} (observed env alone: {alone:.0f} steps/s)")
     st = ppo.choice_stats() if callable(getattr(ppo, "choice_stats", None)) else {}  # a goal-level model
     if st.get("decisions"):  # its choices (in this process: none with --ray)
         print(f"learned_choices: {st['decisions']:.0f} decisions, {100 * st['not_first']:.1f} % differ from the "
               f"frontier agent's pick; frontier {100 * st['frontier']:.1f} %, loop closure "
               f"{100 * st['closure']:.1f} %, turn in place {100 * st['turn']:.1f} %")  # fmt: skip
-    if ppo is not None:  # the learned agent (--model): geometric mean over the maps of T(best) / T(learned)
-        for level in ("T95", "T90"):
-            t = res.t90(level)
-            m = res.metrics()
-            for g in res.results:
-                r, lo, hi = paired_bootstrap_geomean(m[g][best][level], m[g]["ppo"][level])
-                print(f"speedup_{level.lower()}_{g}={r:.4f} [{lo:.4f}, {hi:.4f}]")
-            r, lo, hi = paired_bootstrap_geomean(t[best], t["ppo"])
-            print(f"speedup_{level.lower()}={r:.4f} [{lo:.4f}, {hi:.4f}] ({level} of {best} / {level} of ppo, "
-                  "geometric mean over the maps)")  # fmt: skip
+    if "ppo" in res.agents:  # the learned agent: geometric mean over the maps of T_level(best) / T_level(ppo)
+        m = res.metrics()
+        for g in res.results:
+            lv = res.level_name(g)
+            r, lo, hi = paired_bootstrap_geomean(m[g][best][lv], m[g]["ppo"][lv])
+            print(f"speedup_{g}={r:.4f} [{lo:.4f}, {hi:.4f}]")
+        t = res.times()
+        r, lo, hi = paired_bootstrap_geomean(t[best], t["ppo"])
+        print(f"speedup={r:.4f} [{lo:.4f}, {hi:.4f}] (T_level of {best} / T_level of ppo, geometric mean over "
+              "the maps)")  # fmt: skip
 
 
 if __name__ == "__main__":

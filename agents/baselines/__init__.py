@@ -3,12 +3,13 @@
 Lives here: :mod:`.registry` (``BASELINES``, ``make_baseline``), :mod:`.policy` (the policy interface,
 ``RandomAgent``), :mod:`.planning` (grid path planning), :mod:`.frontier` (frontier, uncertainty-aware
 frontier and lawnmower agents) and :mod:`.tour` (the tour frontier agent; its Held-Karp kernel beside it in
-:mod:`.tour_jit`).
+:mod:`.tour_jit`) and :mod:`.distance_advantage` (the distance-advantage frontier agent).
 
 May import: :mod:`digslam.envs` (observations and spaces), :mod:`digslam.observer.core.scalar_jit` (the
 project's ``njit``); numpy, scipy, numba.
 """
 
+from .distance_advantage import DistanceAdvantageAgent, isolation
 from .frontier import (
     KEEP_FACTOR,
     KEEP_SLACK,
@@ -49,6 +50,7 @@ __all__ = [
     "keep_bound",
     "BASELINES",
     "BaselinePolicy",
+    "DistanceAdvantageAgent",
     "FrontierAgent",
     "LawnmowerAgent",
     "Memory",
@@ -60,6 +62,7 @@ __all__ = [
     "View",
     "dilate",
     "erode",
+    "isolation",
     "line_of_sight",
     "make_baseline",
     "parse",

@@ -7,6 +7,8 @@
   observer's box grows about 17 times faster along arcs than along straight lines;
 * :class:`TourFrontierAgent`: the frontier agent whose goal starts the shortest open tour over the frontier
   clusters (a regret term on the clusters that would leave a detour behind, :mod:`.tour`);
+* :class:`DistanceAdvantageAgent`: the frontier agent whose goal is the frontier cluster close to the robot
+  and far from the other clusters (distance advantage, Ericson et al. 2025, :mod:`.distance_advantage`);
 * :class:`UncertaintyAwareFrontier`: when the tube is wider than a threshold, goes back into clear ground
   near sensed obstacles, visited while the tube was narrow, and turns there until the tube shrinks (active
   loop closure).
@@ -26,6 +28,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from digslam.agents.baselines.distance_advantage import DistanceAdvantageAgent
 from digslam.agents.baselines.frontier import FrontierAgent, LawnmowerAgent, UncertaintyAwareFrontier
 from digslam.agents.baselines.policy import BaselinePolicy, RandomAgent
 from digslam.agents.baselines.tour import TourFrontierAgent
@@ -37,6 +40,7 @@ BASELINES: dict[str, type[BaselinePolicy]] = {
     "frontier": FrontierAgent,
     "uncertainty_frontier": UncertaintyAwareFrontier,
     "tour_frontier": TourFrontierAgent,
+    "distance_advantage": DistanceAdvantageAgent,
 }
 
 
@@ -74,6 +78,7 @@ def make_baseline(name: str, env: Any, seed: int | None = None) -> BaselinePolic
 __all__ = [
     "BASELINES",
     "BaselinePolicy",
+    "DistanceAdvantageAgent",
     "FrontierAgent",
     "LawnmowerAgent",
     "RandomAgent",

@@ -72,7 +72,8 @@ def _font(size: int) -> Any:
         return ImageFont.load_default()
 
 
-def _flat_palette() -> list[int]:
+def flat_palette() -> list[int]:
+    """The GIF palette as PIL's flat list ``[r0, g0, b0, r1, ...]``, in :data:`PALETTE`'s order."""
     return [c for rgb in PALETTE.values() for c in rgb]
 
 
@@ -290,4 +291,5 @@ __all__ = [
     "PANEL_WIDTH",
     "TRAIL",
     "FrameDrawer",
+    "flat_palette",
 ]

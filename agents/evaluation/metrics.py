@@ -3,8 +3,9 @@
 Per episode, from the certified-coverage curve (``curve[k]``: the coverage after ``k`` steps, ``curve[0]``
 at reset, as :class:`~digslam.agents.evaluation.evaluate.EvalResult` keeps it) and the episode's ``info``:
 
-* ``T80``, ``T90``, ``T95``: the first step ``k`` with ``curve[k] >= 0.8`` (0.9, 0.95); a level the episode
-  never reaches counts as the step ``budget`` and its success flag (``S80``, ...) is 0;
+* ``T80``, ``T85``, ``T90``, ``T95``: the first step ``k`` with ``curve[k] >= 0.8`` (0.85, 0.9, 0.95); a level
+  the episode never reaches counts as the step ``budget`` and its success flag (``S80``, ...) is 0; each
+  generator's headline level is one of them (:mod:`.levels`);
 * ``AUC``: the mean certified coverage over steps 1 to 1000; a curve that ends earlier (the episode
   terminated, e.g. on reaching its target, or the step budget was smaller) holds its last value, as the
   evaluator pads its curves: what was certified stays certified;
@@ -29,7 +30,7 @@ from typing import Any
 import numpy as np
 
 #: Certified-coverage levels of the time-to-level metrics.
-LEVELS = (0.8, 0.9, 0.95)
+LEVELS = (0.8, 0.85, 0.9, 0.95)
 #: Steps over which :func:`auc` averages.
 AUC_STEPS = 1000
 
@@ -171,10 +172,10 @@ def paired_bootstrap_geomean(a: np.ndarray, b: np.ndarray, n_boot: int = 10_000,
 
 def metrics_table(per_agent: Mapping[str, Mapping[str, np.ndarray]], levels: Sequence[float] = LEVELS) -> str:
     """Markdown table, one row per agent: mean / median of each ``T..`` with its success rate, ``AUC``, path
-    length, collisions and final tube width (means)."""
+    length, collisions and the final pose box's width (means)."""
     names = [level_name(v) for v in levels]
     head = [f"{n} mean / median (success)" for n in names]
-    head += ["AUC", "path (m)", "collisions", "final tube (m)"]
+    head += ["AUC", "path (m)", "collisions", "final pose box (m)"]
     lines = ["| agent | " + " | ".join(head) + " |", "|---" * (len(head) + 1) + "|"]
     for agent, values in per_agent.items():
         s = summarize(values)

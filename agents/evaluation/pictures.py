@@ -26,7 +26,7 @@ from digslam.agents.evaluation.frames import (
     PALETTE,
     PANEL_WIDTH,
     FrameDrawer,
-    _flat_palette,
+    flat_palette,
 )
 
 
@@ -99,7 +99,7 @@ def demo_episode(
 
 def write_gif(frames: list[Any], path: str | Path, fps: int) -> Path:
     """Write ``P``-mode frames sharing :data:`PALETTE` as a looping GIF."""
-    pal = _flat_palette()
+    pal = flat_palette()
     for f in frames:
         f.putpalette(pal)
     p = Path(path)

@@ -2,18 +2,22 @@
 
 :func:`run_suite` runs every agent on ``n_maps`` levels of each generator of :data:`GENERATORS` (the first
 ``n_maps`` seeds of a split of :mod:`digslam.envs.splits`, the test split by default; the same levels for
-every agent), each episode with ``target=1.0`` (no early end at 0.8: the curve is not capped) and a step
-budget of ``steps`` (3000). :class:`SuiteResult` turns the curves into the metrics of :mod:`.metrics` per
-generator and writes the leaderboard: a Markdown table (per agent: T90 per generator with its success
-rate, and over all maps T90, AUC and the final tube width, the ratio of the best baseline's mean T90 to the
-agent's with its paired bootstrap 95 % interval) and a figure (T90 per generator, and the mean certified
-coverage curves with their spread).
+every agent), each episode with ``target=1.0`` (no early end: the curve is not capped) and a step budget of
+``steps`` (3000). :class:`SuiteResult` turns the curves into the metrics of :mod:`.metrics` per generator
+and writes the leaderboard. Its headline is ``T_level``, the steps to each generator's target level
+(:data:`.levels.TARGET_LEVELS`, fixed on the validation split): a Markdown table (per agent: ``T_level`` per
+generator with its success rate, and over all maps ``T_level``, T90, AUC and the final pose box, the
+geometric mean over the maps of ``T_level(best baseline) / T_level(agent)`` with its paired bootstrap 95 %
+interval) and a figure (``T_level`` per generator, and the mean certified coverage curves with their
+spread).
 
 >>> curves = {"a": np.array([[0.0, 0.95, 0.95]]), "b": np.array([[0.0, 0.5, 0.91]])}
 >>> zero = {"a": np.zeros(1), "b": np.zeros(1)}
 >>> r = SuiteResult({"room": EvalResult(curves, {}, zero, zero)}, steps=2)
->>> r.t90()["a"].tolist(), r.t90()["b"].tolist(), r.best(["a", "b"])
+>>> r.times("T90")["a"].tolist(), r.times("T90")["b"].tolist(), r.best(["a", "b"])
 ([1.0], [2.0], 'a')
+>>> r.times()["b"].tolist(), r.level_name("room")  # the room's target level, 0.95
+([2.0], 'T95')
 """
 
 from __future__ import annotations
@@ -27,7 +31,8 @@ from typing import Any
 import numpy as np
 
 from digslam.agents.evaluation.evaluate import EvalResult, evaluate
-from digslam.agents.evaluation.metrics import paired_bootstrap_ratio
+from digslam.agents.evaluation.levels import TARGET_LEVELS, level_metric
+from digslam.agents.evaluation.metrics import paired_bootstrap_geomean
 
 #: Generator name -> (environment id, keywords): the suite's worlds.
 GENERATORS: dict[str, tuple[str, dict[str, Any]]] = {
@@ -64,59 +69,79 @@ class SuiteResult:
         """generator -> agent -> metric -> ``(n_maps,)`` (:meth:`.evaluate.EvalResult.metrics`)."""
         return {g: r.metrics() for g, r in self.results.items()}
 
-    def t90(self, level: str = "T90") -> dict[str, np.ndarray]:
-        """agent -> the ``level`` metric over every map of every generator, generators in order (paired
-        across agents)."""
-        m = self.metrics()
-        return {a: np.concatenate([m[g][a][level] for g in self.results]) for a in self.agents}
+    def level_name(self, generator: str) -> str:
+        """The metric of ``generator``'s target level (``"T95"`` for 0.95; :data:`.levels.TARGET_LEVELS`,
+        ``"T90"`` for a generator without one)."""
+        return level_metric(TARGET_LEVELS[generator]) if generator in TARGET_LEVELS else "T90"
 
-    def _rank(self, agent: str, level: str = "T90") -> tuple[float, float]:
-        """Sort key: the mean ``level`` over all maps, then the larger mean AUC (when no one reaches it)."""
+    def times(self, level: str | None = None) -> dict[str, np.ndarray]:
+        """agent -> the ``level`` metric (``"T90"``, ``"S90"``, ...) over every map of every generator,
+        generators in order (paired across agents); None: each generator's target level, ``T_level``."""
+        m = self.metrics()
+        return {a: np.concatenate([m[g][a][level or self.level_name(g)] for g in self.results])
+                for a in self.agents}  # fmt: skip
+
+    def t90(self, level: str = "T90") -> dict[str, np.ndarray]:
+        """:meth:`times` at a fixed level (``"T90"`` by default) on every generator."""
+        return self.times(level)
+
+    def _rank(self, agent: str, level: str | None = None) -> tuple[float, float]:
+        """Sort key: the mean ``level`` (None: ``T_level``) over all maps, then the larger mean AUC."""
         m = self.metrics()
         auc = np.concatenate([m[g][agent]["AUC"] for g in self.results])
-        return float(np.mean(self.t90(level)[agent])), -float(np.mean(auc))
+        return float(np.mean(self.times(level)[agent])), -float(np.mean(auc))
 
-    def best(self, candidates: Iterable[str], level: str = "T90") -> str:
-        """The candidate with the smallest mean ``level`` over all maps (ties: the larger mean AUC, then the
-        first)."""
+    def best(self, candidates: Iterable[str], level: str | None = None, generator: str | None = None) -> str:
+        """The candidate with the smallest mean ``level`` (None: ``T_level``) over all maps, or over the maps
+        of one ``generator`` (ties: the larger mean AUC, then the first)."""
         names = [a for a in candidates if a in self.agents]
         if not names:
             raise ValueError("candidates: none of them ran")
+        if generator is not None:
+            part = SuiteResult({generator: self.results[generator]}, self.steps, self.split, self.seeds)
+            return part.best(names, level)
         return min(names, key=lambda a: (*self._rank(a, level), names.index(a)))
 
-    def success(self, agent: str, level: str = "S90") -> float:
-        """Share of all maps on which ``agent`` reached the level (``S90``: 0.9 certified coverage)."""
+    def success(self, agent: str, level: str | None = None) -> float:
+        """Share of all maps on which ``agent`` reached the level (``"S90"``: 0.9 certified coverage; None:
+        each generator's target level)."""
+        if level is not None:
+            return float(np.mean(self.times(level)[agent]))
         m = self.metrics()
-        return float(np.mean(np.concatenate([m[g][agent][level] for g in self.results])))
+        flags = [m[g][agent]["S" + self.level_name(g)[1:]] for g in self.results]
+        return float(np.mean(np.concatenate(flags)))
 
     def table(self, baselines: Sequence[str]) -> str:
-        """The leaderboard (Markdown), agents sorted by mean T90 over all maps (then AUC); the ratio column is
-        ``mean T90(best baseline) / mean T90(agent)`` (> 1: faster than the best baseline) with its paired
-        bootstrap 95 % interval."""
-        m, t = self.metrics(), self.t90()
+        """The leaderboard (Markdown), agents sorted by mean ``T_level`` over all maps (then AUC); the ratio
+        column is the geometric mean over the maps of ``T_level(best baseline) / T_level(agent)`` (> 1:
+        faster than the best baseline) with its paired bootstrap 95 % interval."""
+        m, t, t90 = self.metrics(), self.times(), self.times("T90")
         best = self.best(baselines) if any(b in t for b in baselines) else None
         gens = list(self.results)
-        head = ["agent"] + [f"T90 {g} (success)" for g in gens]
-        head += ["T90 all (success)", "AUC", "final tube (m)", "T90 best baseline / T90 [95 % CI]"]
+        head = ["agent"] + [f"{self.level_name(g)} {g} (success)" for g in gens]
+        head += ["T_level all (success)", "T90 all", "AUC", "final pose box (m)",
+                 "speedup vs best baseline [95 % CI]"]  # fmt: skip
         lines = ["| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
         for a in sorted(self.agents, key=self._rank):
             cells = [a]
             for g in gens:
-                cells.append(f"{np.mean(m[g][a]['T90']):.0f} ({np.mean(m[g][a]['S90']):.0%})")
+                lv = self.level_name(g)
+                cells.append(f"{np.mean(m[g][a][lv]):.0f} ({np.mean(m[g][a]['S' + lv[1:]]):.0%})")
             auc = np.concatenate([m[g][a]["AUC"] for g in gens])
-            tube = np.concatenate([m[g][a]["final_tube"] for g in gens])
+            box = np.concatenate([m[g][a]["final_tube"] for g in gens])
             cells.append(f"{np.mean(t[a]):.0f} ({self.success(a):.0%})")
-            cells += [f"{np.mean(auc):.3f}", f"{np.nanmean(tube):.3f}" if np.isfinite(tube).any() else "n/a"]
+            cells.append(f"{np.mean(t90[a]):.0f}")
+            cells += [f"{np.mean(auc):.3f}", f"{np.nanmean(box):.3f}" if np.isfinite(box).any() else "n/a"]
             if best is None:
                 cells.append("n/a")
             else:
-                r, lo, hi = paired_bootstrap_ratio(t[best], t[a])
+                r, lo, hi = paired_bootstrap_geomean(t[best], t[a])
                 cells.append(f"{r:.3f} [{lo:.3f}, {hi:.3f}]" + (" (best baseline)" if a == best else ""))
             lines.append("| " + " | ".join(cells) + " |")
         return "\n".join(lines)
 
     def figure(self, path: str | Path) -> Path:
-        """T90 per generator (bars, mean over the maps, with the spread as error bars) beside the mean
+        """``T_level`` per generator (bars, mean over the maps, with the spread as error bars) beside the mean
         certified coverage against steps (all maps of all generators, ± one standard deviation); returns the
         path written (matplotlib, Agg)."""
         import matplotlib
@@ -128,8 +153,8 @@ class SuiteResult:
         fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(11.0, 4.0), dpi=110)
         width = 0.8 / max(len(agents), 1)
         for k, a in enumerate(agents):
-            mean = [float(np.mean(m[g][a]["T90"])) for g in gens]
-            sd = [float(np.std(m[g][a]["T90"])) for g in gens]
+            mean = [float(np.mean(m[g][a][self.level_name(g)])) for g in gens]
+            sd = [float(np.std(m[g][a][self.level_name(g)])) for g in gens]
             ax0.bar(np.arange(len(gens)) + (k - (len(agents) - 1) / 2) * width, mean, width, yerr=sd,
                     label=a, color=f"C{k}", capsize=2)  # fmt: skip
             curves = np.concatenate([self.results[g].curves[a] for g in gens])
@@ -137,10 +162,11 @@ class SuiteResult:
             x = np.arange(mu.size)
             ax1.plot(x, mu, color=f"C{k}", label=a)
             ax1.fill_between(x, np.clip(mu - s, 0, 1), np.clip(mu + s, 0, 1), color=f"C{k}", alpha=0.15)
-        ax0.set_xticks(np.arange(len(gens)), gens)
-        ax0.set_ylabel(f"T90 (steps; {self.steps} = not reached)")
-        ax0.set_title("steps to 0.9 certified coverage")
-        ax1.axhline(0.9, color="grey", lw=0.8, ls=":")
+        ax0.set_xticks(np.arange(len(gens)), [f"{g} ({self.level_name(g)})" for g in gens])
+        ax0.set_ylabel(f"T_level (steps; {self.steps} = not reached)")
+        ax0.set_title("steps to each generator's target level")
+        for g in gens:
+            ax1.axhline(TARGET_LEVELS.get(g, 0.9), color="grey", lw=0.8, ls=":")
         ax1.set_xlabel("step")
         ax1.set_ylabel("certified coverage")
         ax1.set_ylim(0, 1)
@@ -158,14 +184,64 @@ class SuiteResult:
         data = {
             "steps": self.steps, "split": self.split, "seeds": self.seeds,
             "generators": {g: {"curves": {a: c.tolist() for a, c in r.curves.items()},
+                               "true_curves": {a: c.tolist() for a, c in r.true_curves.items()},
                                "metrics": {a: {k: v.tolist() for k, v in mm.items()}
                                            for a, mm in r.metrics().items()}}
                            for g, r in self.results.items()},
         }  # fmt: skip
         out = Path(path)
         out.parent.mkdir(parents=True, exist_ok=True)
-        out.write_text(json.dumps(data))
+        out.write_text(json.dumps(data).replace("NaN", "null"))
         return out
+
+    @classmethod
+    def from_json(cls, path: str | Path) -> SuiteResult:
+        """Read a suite written by :meth:`to_json` (curves, and the collisions, final pose box and path
+        length of its metrics); several runs of other agents on the same levels merge with :func:`merge`.
+
+        Raises:
+            ValueError: the file is not a suite's JSON.
+        """
+        try:
+            data = json.loads(Path(path).read_text())
+            results = {}
+            for g, d in data["generators"].items():
+                met = {a: {k: np.array([np.nan if x is None else x for x in v], dtype=np.float64)
+                           for k, v in mm.items()} for a, mm in d["metrics"].items()}  # fmt: skip
+                results[g] = EvalResult(
+                    curves={a: np.array(c, dtype=np.float64) for a, c in d["curves"].items()},
+                    true_curves={
+                        a: np.array(c, dtype=np.float64) for a, c in d.get("true_curves", {}).items()
+                    },
+                    collisions={a: met[a]["collisions"] for a in met},
+                    final_tube_width={a: met[a]["final_tube"] for a in met},
+                    path_lengths={a: met[a]["path_length"] for a in met},
+                )
+            return cls(
+                results, int(data["steps"]), str(data.get("split", "test")), list(data.get("seeds", []))
+            )
+        except (KeyError, TypeError, json.JSONDecodeError) as exc:
+            raise ValueError(f"path: {path} is not a suite JSON ({exc!r})") from None
+
+
+def merge(parts: Sequence[SuiteResult]) -> SuiteResult:
+    """One suite of every part's agents: the parts ran the same levels (split, seeds and steps), each its
+    own agents (or the same generators for several agents).
+
+    Raises:
+        ValueError: the parts ran different levels or step budgets.
+    """
+    first = parts[0]
+    for p in parts[1:]:
+        if (p.steps, p.split, list(p.seeds)) != (first.steps, first.split, list(first.seeds)):
+            raise ValueError(
+                "parts: ran different levels or step budgets; merge only runs of the same levels"
+            )
+    results: dict[str, EvalResult] = {}
+    for p in parts:
+        for g, r in p.results.items():
+            results[g] = merge_agents([results[g], r]) if g in results else r
+    return SuiteResult(results, first.steps, first.split, list(first.seeds))
 
 
 def run_suite(
@@ -244,19 +320,27 @@ def steps_per_second(policy: Any, env_id: str = "digslam/DigCoverage-v0", steps:
                      env_kwargs: Mapping[str, Any] | None = None) -> float:  # fmt: skip
     """Observed environment steps per second of ``policy`` driving one environment in this process (the
     policy's own time included), resetting to the next level whenever an episode ends; timed after one
-    untimed step (compiled kernels loaded)."""
+    untimed step (compiled kernels loaded). ``policy=None`` measures the observed environment alone: a
+    fixed action (forward at 0.6 while turning at 0.2, so the robot sweeps new ground and meets walls)
+    instead of an agent, the denominator of ``eval_over_observed``."""
     import time
 
     from digslam.agents.evaluation.evaluate import make_env
 
     env = make_env(env_id, steps + 1, {**SUITE_KWARGS, **dict(env_kwargs or {})})
+    fixed = np.array([0.6, 0.2], np.float32)
+
+    def act(obs: Any) -> np.ndarray:
+        return fixed if policy is None else np.asarray(policy.predict(obs)[0], np.float32)
+
     try:
+        if policy is not None and hasattr(policy, "reset") and not hasattr(policy, "policy"):
+            policy.reset()
         obs, _ = env.reset(seed=seed)
-        obs = env.step(np.asarray(policy.predict(obs)[0], np.float32))[0]
+        obs = env.step(act(obs))[0]
         t0 = time.perf_counter()
         for _ in range(steps):
-            action = np.asarray(policy.predict(obs)[0], np.float32)
-            obs, _, terminated, truncated, _ = env.step(action)
+            obs, _, terminated, truncated, _ = env.step(act(obs))
             if terminated or truncated:
                 seed += 1
                 obs, _ = env.reset(seed=seed)
@@ -270,6 +354,7 @@ __all__ = [
     "SUITE_KWARGS",
     "SuiteResult",
     "check_generators",
+    "merge",
     "merge_agents",
     "run_suite",
     "steps_per_second",

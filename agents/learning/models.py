@@ -109,23 +109,27 @@ def _goals() -> Any:
 
 def best_agent(path: str | Path | None = None) -> tuple[str, str]:
     """``(agent, why)``: the best agent of the leaderboard file ``path`` (None: :data:`LEADERBOARD`), the
-    agent name the benchmark ranked first by mean T90 over the test maps of every generator, and a line
-    saying where that comes from; ``("frontier", ...)`` when the file is missing or damaged."""
+    agent name the benchmark ranked first by mean ``T_level`` (the steps to each generator's target level)
+    over the test maps of every generator, and a line saying where that comes from; ``("frontier", ...)``
+    when the file is missing or damaged."""
     path = Path(path) if path is not None else LEADERBOARD
     try:
         data = json.loads(path.read_text())
         name = str(data["best"])
-        t90, maps, gens = float(data["T90_mean"]), int(data["maps"]), len(data["generators"])
-        why = f"mean T90 {t90:.0f} steps over {maps} test maps x {gens} generators"
+        t, maps, gens = float(data["T_level_mean"]), int(data["maps"]), len(data["generators"])
+        why = f"mean T_level {t:.0f} steps over {maps} test maps x {gens} generators"
         return name, f"best on the leaderboard ({path.name}: {why})"
     except (OSError, ValueError, KeyError, TypeError):
         return "frontier", f"no readable leaderboard at {path}; the frontier agent"
 
 
-def leaderboard_record(best: str, t90_mean: float, maps: int, steps: int, generators: list[str]) -> dict:
-    """The content of a leaderboard file (:func:`best_agent` reads it back)."""
-    return {"best": best, "T90_mean": float(t90_mean), "maps": int(maps), "steps": int(steps),
-            "generators": list(generators), "split": "test"}  # fmt: skip
+def leaderboard_record(best: str, t_level_mean: float, maps: int, steps: int, generators: list[str],
+                       levels: dict[str, float] | None = None) -> dict:  # fmt: skip
+    """The content of a leaderboard file (:func:`best_agent` reads it back): the best agent, its mean
+    ``T_level`` and the target levels it was measured at."""
+    return {"best": best, "T_level_mean": float(t_level_mean), "target_levels": dict(levels or {}),
+            "maps": int(maps), "steps": int(steps), "generators": list(generators),
+            "split": "test"}  # fmt: skip
 
 
 def model_env_kwargs(model: str | Path | None = None) -> dict[str, Any]:

@@ -95,7 +95,7 @@ def test_the_demo_runs_the_best_agent_of_the_shipped_leaderboard_and_says_which(
     name, policy, kwargs = cli.resolve_agent("best", cli.DEFAULT_ENV, None)
     assert name == "lawnmower" and kwargs == {} and type(policy).__name__ == "LawnmowerAgent"
     assert (
-        "--agent best: lawnmower, best on the leaderboard (board.json: mean T90 812 steps"
+        "--agent best: lawnmower, best on the leaderboard (board.json: mean T_level 812 steps"
         in capsys.readouterr().out
     )
     board.write_text("{not json")
