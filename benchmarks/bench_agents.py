@@ -20,8 +20,8 @@ baseline with its paired bootstrap 95 % interval), writes ``leaderboard.md``, ``
 * ``heuristic_level_success=<share of the test maps, over all generators, on which the best heuristic
   reaches its generator's level>``;
 * ``eval_steps_per_s=<observed env steps per second with the frontier agent, one process>`` and
-  ``eval_over_observed=<that over the observed env's steps per second without an agent, a fixed action,
-  measured in the same process>``;
+  ``eval_over_observed=<that over the observed env's own steps per second on the same path, its step calls
+  timed apart from the agent's in the same run>`` (:func:`digslam.agents.evaluation.suite.eval_rates`);
 * with a learned model: ``speedup_<generator>=`` and ``speedup=<geometric mean over the test maps of all
   generators of T_level(best heuristic) / T_level(learned)> [paired bootstrap 95 % interval]``.
 
@@ -58,7 +58,7 @@ from digslam.agents.baselines.registry import BASELINES, make_baseline
 from digslam.agents.evaluation.levels import TARGET_LEVELS, format_levels
 from digslam.agents.evaluation.metrics import paired_bootstrap_geomean
 from digslam.agents.evaluation.ray_eval import run_suite_ray
-from digslam.agents.evaluation.suite import SuiteResult, check_generators, merge, run_suite, steps_per_second
+from digslam.agents.evaluation.suite import SuiteResult, check_generators, eval_rates, merge, run_suite
 from digslam.agents.learning.models import leaderboard_record
 
 ENV_ID = "digslam/DigCoverage-v0"
@@ -218,14 +218,15 @@ def main() -> None:
     best = res.best(baselines)
     for g in res.results:
         print(f"best_heuristic_{g}={res.best(baselines, generator=g)}")
-    rate = steps_per_second(policies["frontier"], ENV_ID, steps=min(2000, 10 * steps), env_kwargs=common)
-    alone = steps_per_second(None, ENV_ID, steps=min(2000, 10 * steps), env_kwargs=common)
+    rate, alone = eval_rates(policies["frontier"], ENV_ID, steps=min(4000, 10 * steps), env_kwargs=common)
     levels = {g: TARGET_LEVELS.get(g, 0.9) for g in res.results}
     print(f"target_levels={format_levels(levels)}")
     print(f"best_heuristic={best}")
     print(f"heuristic_level_success={res.success(best):.4f}")
     print(f"eval_steps_per_s={rate:.0f}")
-    print(f"eval_over_observed={rate / alone:.3f} (observed env alone: {alone:.0f} steps/s)")
+    print(
+        f"eval_over_observed={rate / alone:.3f} (the observed env alone on the same path: {alone:.0f} steps/s)"
+    )
     st = ppo.choice_stats() if callable(getattr(ppo, "choice_stats", None)) else {}  # a goal-level model
     if st.get("decisions"):  # its choices (in this process: none with --ray)
         print(f"learned_choices: {st['decisions']:.0f} decisions, {100 * st['not_first']:.1f} % differ from the "

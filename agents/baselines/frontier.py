@@ -20,10 +20,11 @@ either way.
 * loop closure (:class:`UncertaintyAwareFrontier`): pixels next to sensed obstacles (penumbra) that the
   robot passed while its tube was at most half as wide as now.
 
-Two ways an episode used to stop for good, now handled (``rooms``, validation levels): with every clear
-pixel visited, the unexplored may lie beyond a corridor seen only in penumbra, so the penumbra pixels next to
-dark ground become goals (``penumbra_frontier``); and a robot that drives without moving (pressed into a
-door frame the map showed as free) blocks the pixel ahead and backs off (``unstick``). A waypoint so close
+Two ways an episode would stop for good are handled (``rooms``, validation levels): the unexplored may lie
+beyond a corridor seen only in penumbra, so the penumbra pixels next to dark ground and deep in the penumbra
+are goals too, at ``penumbra_penalty``, beside the clear tiers (``penumbra_frontier``); and a robot that
+drives without moving (pressed into a door frame the map showed as free) blocks the pixel ahead and backs
+off (``unstick``). A waypoint so close
 that the driver counts it as reached at once is moved one pixel on along the path.
 
 >>> from gymnasium import spaces
@@ -37,6 +38,7 @@ that the driver counts it as reached at once is moved one pixel on along the pat
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -64,6 +66,14 @@ def keep_bound(best: float) -> float:
 #: Stall detection (:meth:`NavigatingAgent._stalled`): over ``STALL_STEPS`` driving steps the robot covered
 #: less than ``STALL_SHARE`` of the commanded distance; it then backs off for ``BACK_STEPS`` steps.
 STALL_STEPS, STALL_SHARE, BACK_STEPS = 8, 0.25, 3
+
+
+@functools.lru_cache(maxsize=8)
+def _centres(m: int) -> np.ndarray:
+    """``(2, m, m)`` read-only row and column coordinates of the pixel centres of an ``m x m`` map."""
+    out = np.mgrid[:m, :m] + 0.5
+    out.flags.writeable = False
+    return out
 
 
 class NavigatingAgent(BaselinePolicy):
@@ -168,7 +178,7 @@ class NavigatingAgent(BaselinePolicy):
             return back
         near = self._disk(m, view.pos, self.visit_radius / px)
         mem.visited |= near
-        mem.best_tube[near] = np.minimum(mem.best_tube[near], view.tube)
+        np.minimum(mem.best_tube, view.tube, out=mem.best_tube, where=near)
         if mem.goal is not None and np.hypot(*(np.array(mem.goal) + 0.5 - view.pos)) < 1.0:
             self._goal_reached(view, mem)
             mem.goal = mem.waypoint = None
@@ -271,10 +281,13 @@ class FrontierAgent(NavigatingAgent):
             steps): mean T90 1603 against 1807 steps for the former defaults (0, and ``KEEP_FACTOR`` 1.2),
             0.9 reached on 73 % of them against 62 % (the room: T90 472 against 909; the rocks: 96 %
             against 58 %).
-        penumbra_frontier: When no clear pixel is a candidate, take the reachable penumbra pixels next to
-            dark ground not yet visited, those farther from clear ground than the tube's band along walls
-            first (at the ``unvisited_penalty``): a corridor that the cones saw only in penumbra is otherwise
-            never entered.
+        penumbra_frontier: Also take as goals the reachable penumbra pixels next to dark ground not yet
+            visited that lie farther from clear ground than the tube's band along walls (a corridor that the
+            cones saw only in penumbra, otherwise entered only once every clear pixel was visited), at the
+            ``penumbra_penalty``; when no pixel is a candidate at all, any such penumbra pixel next to dark
+            ground (at the ``unvisited_penalty``). On the validation levels (24 per generator, 3000 steps)
+            the deep pixels as goals beside the clear tiers lifted the rooms levels certified to 0.8 from
+            83 % to 96 % (mean T80 2525 -> 2428) and changed nothing on room, rocks and caves.
         **kw: :class:`NavigatingAgent` arguments.
     """
 
@@ -321,17 +334,19 @@ class FrontierAgent(NavigatingAgent):
         cost[free] = dist[free] + self.unvisited_penalty / px
         cost[pen] = dist[pen] + self.penumbra_penalty / px
         cost[dark] = dist[dark]
-        if self.penumbra_frontier and not np.isfinite(cost).any():
-            # no clear goal left: the unexplored may lie beyond a passage seen only in penumbra (a corridor
-            # that the sonar cones, cut short by its walls, never cleared); go to its edge with dark ground,
-            # deeper in the penumbra than the band that the tube puts along every wall first, then any
+        if self.penumbra_frontier:
+            # the unexplored may lie beyond a passage seen only in penumbra (a corridor that the sonar cones,
+            # cut short by its walls, never cleared): its edge with dark ground, deeper in the penumbra than
+            # the band that the tube puts along every wall, is a goal beside the clear tiers; with no goal at
+            # all, any edge of the penumbra with dark ground
             edge = np.isfinite(dist) & view.penumbra & pl.dilate(view.dark, 1) & ~mem.visited
             deep = edge & ~pl.dilate(view.clear, int(math.ceil(view.tube / px)) + 2)
-            edge = deep if deep.any() else edge
-            cost[edge] = dist[edge] + self.unvisited_penalty / px
+            if deep.any():
+                cost[deep] = np.minimum(cost[deep], dist[deep] + self.penumbra_penalty / px)
+            elif not np.isfinite(cost).any():
+                cost[edge] = dist[edge] + self.unvisited_penalty / px
         if self.turn_weight > 0:
-            m = view.clear.shape[0]
-            rr, cc = np.mgrid[:m, :m] + 0.5
+            rr, cc = _centres(view.clear.shape[0])
             err = np.abs(
                 np.angle(np.exp(1j * (np.arctan2(view.pos[0] - rr, cc - view.pos[1]) - view.heading)))
             )
@@ -383,7 +398,7 @@ class LawnmowerAgent(NavigatingAgent):
         m = view.clear.shape[0]
         lanes = mem.extra.setdefault("lanes", self.lanes(m))
         i = mem.extra.setdefault("lane", 0) % len(lanes)
-        rr, cc = np.mgrid[:m, :m] + 0.5
+        rr, cc = _centres(m)
         d = np.hypot(rr - lanes[i, 0], cc - lanes[i, 1])
         return np.where(reach, 1e3 * d + dist, np.inf)  # nearest to the lane end, then shortest
 

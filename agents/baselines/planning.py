@@ -5,7 +5,9 @@ top = largest ``y``; ``"state"`` with the pose box normalised to ``[-1, 1]`` ove
 runs on the ``m x m`` map in pixel coordinates ``(row, col)``:
 
 * :func:`shortest_paths`: Dijkstra over the 8-connected graph of traversable pixels (``scipy.sparse.csgraph``
-  over :func:`pixel_graph`); :func:`path_lengths` from several pixels at once;
+  over the graph of :func:`pixel_graph`, whose tie-breaking between equal paths the agents' decisions
+  follow); :func:`path_lengths` from several pixels at once and :func:`pair_lengths` between them (compiled,
+  :mod:`.planning_jit`: the same lengths bit for bit);
 * :func:`path_to`: the pixel path from the predecessor array (a loop over the path's pixels, not the grid);
 * :func:`line_of_sight`: the farthest path pixel reachable in a straight line over traversable pixels
   (string pulling, vectorised over the path and its samples);
@@ -24,13 +26,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import ndimage
-from scipy.sparse import coo_matrix, csr_matrix
+from scipy.sparse import csr_array, csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
-#: 8-neighbourhood offsets (dr, dc) and their lengths (pixels).
-_OFFSETS = [(0, 1), (1, -1), (1, 0), (1, 1)]
+from digslam.agents.baselines import planning_jit as pj
+
+#: The 8-neighbourhood (the structuring element of :func:`erode` and :func:`dilate`).
 SQUARE = np.ones((3, 3), dtype=bool)
+_ONE = np.ones((1, 1))  # the kernels' weight argument when unweighted (not read)
 
 
 def shortest_paths(
@@ -50,7 +53,9 @@ def shortest_paths(
     if not (0 <= r0 < h and 0 <= c0 < w):
         raise ValueError(f"start: {start} lies outside the {h} x {w} grid")
     free[r0, c0] = True
-    dist, pred = dijkstra(pixel_graph(free, weight), indices=r0 * w + c0, return_predecessors=True)
+    indptr, indices, data = pj.grid_csr(*_grid_args(free, weight))
+    graph = csr_array((data, indices, indptr), shape=(h * w, h * w))  # a csr_array: dijkstra takes it as is
+    dist, pred = dijkstra(graph, indices=r0 * w + c0, return_predecessors=True)
     return dist.reshape(h, w), pred
 
 
@@ -70,34 +75,44 @@ def path_lengths(free: np.ndarray, starts: np.ndarray, weight: np.ndarray | None
     free[starts[:, 0], starts[:, 1]] = True
     if not len(starts):
         return np.zeros((0, h, w))
-    dist = dijkstra(pixel_graph(free, weight), indices=starts[:, 0] * w + starts[:, 1])
-    return np.asarray(dist).reshape(len(starts), h, w)
+    flat = starts[:, 0] * w + starts[:, 1]
+    dist = pj.grid_lengths(*_grid_args(free, weight), flat, np.zeros(0, dtype=np.int64))
+    return dist.reshape(len(starts), h, w)
+
+
+def pair_lengths(free: np.ndarray, starts: np.ndarray, weight: np.ndarray | None = None) -> np.ndarray:
+    """``(S, S)`` path lengths between the ``(S, 2)`` pixels ``starts``: ``path_lengths(free, starts,
+    weight)[:, starts[:, 0], starts[:, 1]]``, each search stopped once every start is settled.
+
+    >>> free = np.ones((3, 4), dtype=bool); free[:2, 1] = False
+    >>> pair_lengths(free, np.array([[0, 0], [0, 3]])).round(3).tolist()
+    [[0.0, 6.414], [6.414, 0.0]]
+    """
+    free = np.asarray(free, dtype=bool).copy()
+    starts = np.asarray(starts, dtype=np.int64).reshape(-1, 2)
+    h, w = free.shape
+    if starts.size and not ((starts >= 0).all() and (starts[:, 0] < h).all() and (starts[:, 1] < w).all()):
+        raise ValueError(f"starts: a pixel lies outside the {h} x {w} grid")
+    free[starts[:, 0], starts[:, 1]] = True
+    flat = starts[:, 0] * w + starts[:, 1]
+    return pj.grid_lengths(*_grid_args(free, weight), flat, flat)[:, flat]
 
 
 def pixel_graph(free: np.ndarray, weight: np.ndarray | None = None) -> csr_matrix:
-    """The 8-connected graph of the ``free`` pixels as a sparse matrix over the flat pixel indices (edges
-    built with whole-array numpy, no per-cell Python loop): a move costs its length (1 or √2), times the
-    mean of its two ends' ``weight`` when given; diagonal moves need both side pixels free."""
+    """The 8-connected graph of the ``free`` pixels as a sparse matrix over the flat pixel indices (built by
+    the compiled :func:`.planning_jit.grid_csr`, each row's columns ascending): a move costs its length (1 or
+    √2), times the mean of its two ends' ``weight`` when given; diagonal moves need both side pixels free."""
     h, w = free.shape
-    idx = np.arange(h * w).reshape(h, w)
-    rows, cols, wts = [], [], []
-    for dr, dc in _OFFSETS:  # four edge directions, each a whole-array operation
-        a = free[: h - dr, max(-dc, 0) : w - max(dc, 0)]
-        b = free[dr:, max(dc, 0) : w + min(dc, 0) or None]
-        ok = a & b
-        if dr and dc:  # diagonal: both side pixels free
-            side1 = free[: h - dr, max(dc, 0) : w + min(dc, 0) or None]
-            ok &= side1 & free[dr:, max(-dc, 0) : w - max(dc, 0)]
-        ia = idx[: h - dr, max(-dc, 0) : w - max(dc, 0)][ok]
-        ib = idx[dr:, max(dc, 0) : w + min(dc, 0) or None][ok]
-        rows += [ia, ib]
-        cols += [ib, ia]
-        step = np.full(ia.size, math.hypot(dr, dc))
-        if weight is not None:
-            step = step * 0.5 * (weight.flat[ia] + weight.flat[ib])
-        wts += [step, step]
-    r, c = np.concatenate(rows), np.concatenate(cols)
-    return coo_matrix((np.concatenate(wts), (r, c)), shape=(h * w, h * w)).tocsr()
+    indptr, indices, data = pj.grid_csr(*_grid_args(free, weight))
+    return csr_matrix((data, indices, indptr), shape=(h * w, h * w))
+
+
+def _grid_args(free: np.ndarray, weight: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The kernels' ``(free, weight, weighted)``: contiguous bool and float64 arrays."""
+    free = np.ascontiguousarray(free, dtype=bool)
+    if weight is None:
+        return free, _ONE, False
+    return free, np.ascontiguousarray(weight, dtype=np.float64), True
 
 
 def path_to(pred: np.ndarray, shape: tuple[int, int], goal: tuple[int, int]) -> np.ndarray:
@@ -131,14 +146,14 @@ def erode(mask: np.ndarray, k: int = 1) -> np.ndarray:
     """``mask`` eroded by ``k`` pixels (8-neighbourhood); outside the map counts as not in the mask."""
     if k <= 0:
         return mask.copy()
-    return ndimage.binary_erosion(mask, SQUARE, iterations=k, border_value=0)
+    return pj.box_erode(np.ascontiguousarray(mask, dtype=bool), int(k))
 
 
 def dilate(mask: np.ndarray, k: int = 1) -> np.ndarray:
     """``mask`` dilated by ``k`` pixels (8-neighbourhood)."""
     if k <= 0:
         return mask.copy()
-    return ndimage.binary_dilation(mask, SQUARE, iterations=k)
+    return pj.box_dilate(np.ascontiguousarray(mask, dtype=bool), int(k))
 
 
 def wrap(a: float) -> float:
@@ -163,8 +178,8 @@ def turn_then_go(
     """
     e = float(bearing_err)
     if moving and abs(e) > stop_tol or not moving and abs(e) > go_tol:
-        return np.array([0.0, float(np.clip(e / turn_per_step, -1.0, 1.0))], dtype=np.float32), False
-    v = float(np.clip(distance / step_length, 0.2, 1.0))
+        return np.array([0.0, min(max(e / turn_per_step, -1.0), 1.0)], dtype=np.float32), False
+    v = min(max(float(distance) / step_length, 0.2), 1.0)
     return np.array([v, 0.0], dtype=np.float32), True
 
 
@@ -173,6 +188,7 @@ __all__ = [
     "dilate",
     "erode",
     "line_of_sight",
+    "pair_lengths",
     "path_to",
     "shortest_paths",
     "turn_then_go",

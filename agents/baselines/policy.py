@@ -27,6 +27,7 @@ import numpy as np
 from gymnasium import spaces  # noqa: F401  (doctest)
 
 from digslam.agents.baselines import planning as pl
+from digslam.agents.baselines import policy_jit as pj
 
 #: Indices of the observation's ``"state"`` vector (:mod:`digslam.envs.dig_coverage.wrapper`).
 S_COS, S_SIN, S_TUBE, S_ELAPSED, S_CONSISTENT = 4, 5, 7, 8, 10
@@ -48,7 +49,7 @@ class View:
     @property
     def cell(self) -> tuple[int, int]:
         m = self.clear.shape[0]
-        return int(np.clip(self.pos[0], 0, m - 1)), int(np.clip(self.pos[1], 0, m - 1))
+        return int(min(max(float(self.pos[0]), 0.0), m - 1)), int(min(max(float(self.pos[1]), 0.0), m - 1))
 
 
 def parse(obs_map: np.ndarray, state: np.ndarray) -> View:
@@ -150,7 +151,7 @@ class BaselinePolicy:
             fresh = bool(starts.reshape(-1)[i]) or states[i, S_ELAPSED] <= 0
             if mem is None or mem.m != view.clear.shape[0] or fresh:
                 mem = self._mem[i] = Memory(view.clear.shape[0])
-            out[i] = np.clip(self._act(view, mem), -1.0, 1.0) if view.consistent else 0.0
+            out[i] = np.minimum(np.maximum(self._act(view, mem), -1.0), 1.0) if view.consistent else 0.0
             mem.t += 1
         return (out[0] if single else out), None
 
@@ -168,18 +169,9 @@ class BaselinePolicy:
 
     def _disk(self, m: int, centre: np.ndarray, radius_px: float) -> np.ndarray:
         """``(m, m)`` bool: the pixels whose centre lies within ``radius_px`` of ``centre`` (row, column),
-        computed on the disc's bounding window only."""
-        out = np.zeros((m, m), dtype=bool)
-        r2 = radius_px**2
-        (r0, r1), (c0, c1) = (
-            (max(int(math.floor(c - radius_px)) - 1, 0), min(int(math.ceil(c + radius_px)) + 1, m))
-            for c in (float(centre[0]), float(centre[1]))
-        )
-        if r0 < r1 and c0 < c1:
-            rr = np.arange(r0, r1)[:, None]
-            cc = np.arange(c0, c1)[None, :]
-            out[r0:r1, c0:c1] = (rr + 0.5 - centre[0]) ** 2 + (cc + 0.5 - centre[1]) ** 2 <= r2
-        return out
+        computed on the disc's bounding window only (the compiled :func:`.policy_jit.disk`)."""
+        radius_px = float(radius_px)
+        return pj.disk(int(m), float(centre[0]), float(centre[1]), radius_px, radius_px**2)
 
     def _drive(self, view: View, mem: Memory) -> np.ndarray:
         """Turn-then-go towards ``mem.waypoint``; clears it when reached."""

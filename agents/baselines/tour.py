@@ -9,9 +9,10 @@ and before it the TSP ordering of frontier viewpoints) order the frontiers by a 
 
 :class:`TourFrontierAgent` keeps every cost of the frontier agent and adds a regret term: the frontier pixels
 next to dark ground are grouped into clusters (8-connected), the ``max_clusters`` cheapest clusters become
-the stops of a tour, the path lengths between them come from one multi-source Dijkstra over the planner's
-own graph (:func:`.planning.path_lengths`), and :func:`.tour_jit.open_tours` gives for every stop ``i`` the
-length ``R_i`` of the shortest open path from ``i`` through all the others. A pixel of cluster ``i`` costs
+the stops of a tour, the path lengths between them come from one Dijkstra per stop over the planner's own
+graph, each stopped once every stop is settled (:func:`.planning.pair_lengths`), and
+:func:`.tour_jit.open_tours` gives for every stop ``i`` the length ``R_i`` of the shortest open path from
+``i`` through all the others. A pixel of cluster ``i`` costs
 ``tour_weight * (R_i - min R)`` more: the cluster that starts the best tour costs what it did, one that would
 leave a detour behind costs that detour. Clusters outside the tour, the other tiers and the hysteresis are
 those of the frontier agent. Everything comes from the observation, as for every baseline.
@@ -117,19 +118,15 @@ class TourFrontierAgent(FrontierAgent):
         ``max_clusters`` cheapest clusters of at least ``min_cluster`` frontier pixels next to dark ground."""
         dark = self.frontier_tiers(view, mem, reach)[0] & np.isfinite(cost)
         labels, n = ndimage.label(dark, structure=pl.SQUARE)
-        found: list[tuple[float, int, np.ndarray]] = []
-        for lab in range(1, n + 1):
-            mask = labels == lab
-            if np.count_nonzero(mask) < self.min_cluster:
-                continue
-            c = np.where(mask, cost, np.inf)
-            k = int(np.argmin(c))
-            found.append((float(c.flat[k]), k, mask))
-        found.sort(key=lambda t: t[0])
-        found = found[: self.max_clusters]
+        idx = np.flatnonzero(labels)
+        lab, val = labels.ravel()[idx], cost.ravel()[idx]
+        order = np.lexsort((idx, val, lab))  # by cluster, then cost, then flat index (argmin's first)
+        head = order[np.flatnonzero(np.diff(lab[order], prepend=0))]  # each cluster's cheapest pixel
+        big = head[np.bincount(lab, minlength=n + 1)[lab[head]] >= self.min_cluster]
+        chosen = big[np.argsort(val[big], kind="stable")][: self.max_clusters]  # cheapest first
         w = cost.shape[1]
-        pix = np.array([[k // w, k % w] for _, k, _ in found], dtype=np.int64).reshape(-1, 2)
-        return pix, [m for _, _, m in found]
+        pix = np.stack([idx[chosen] // w, idx[chosen] % w], axis=1).astype(np.int64).reshape(-1, 2)
+        return pix, [labels == lab[i] for i in chosen]
 
     def add_regret(self, view: View, mem: Memory, reach: np.ndarray, cost: np.ndarray) -> None:
         """Add ``tour_weight`` times the tour regret to the pixels of every stop's cluster, in place."""
@@ -141,10 +138,9 @@ class TourFrontierAgent(FrontierAgent):
             weight = self.weights(view, eroded)
             weight[mem.blocked] = np.inf
             trav = np.isfinite(weight)
-            lengths = pl.path_lengths(trav, pix, np.where(trav, weight, 1.0))
+            d = pl.pair_lengths(trav, pix, np.where(trav, weight, 1.0))
         else:
-            lengths = pl.path_lengths(reach & ~mem.blocked, pix)
-        d = lengths[:, pix[:, 0], pix[:, 1]]
+            d = pl.pair_lengths(reach & ~mem.blocked, pix)
         regret = tour_regret(d)
         for mask, r in zip(masks, regret, strict=True):
             cost[mask] += self.tour_weight * r

@@ -320,31 +320,39 @@ def steps_per_second(policy: Any, env_id: str = "digslam/DigCoverage-v0", steps:
                      env_kwargs: Mapping[str, Any] | None = None) -> float:  # fmt: skip
     """Observed environment steps per second of ``policy`` driving one environment in this process (the
     policy's own time included), resetting to the next level whenever an episode ends; timed after one
-    untimed step (compiled kernels loaded). ``policy=None`` measures the observed environment alone: a
-    fixed action (forward at 0.6 while turning at 0.2, so the robot sweeps new ground and meets walls)
-    instead of an agent, the denominator of ``eval_over_observed``."""
+    untimed step (compiled kernels loaded). :func:`eval_rates` also gives the env's own share."""
+    return eval_rates(policy, env_id, steps, seed, env_kwargs)[0]
+
+
+def eval_rates(policy: Any, env_id: str = "digslam/DigCoverage-v0", steps: int = 2000, seed: int = 0,
+               env_kwargs: Mapping[str, Any] | None = None) -> tuple[float, float]:  # fmt: skip
+    """``(eval steps/s, observed env steps/s)`` of one run of ``policy`` (see :func:`steps_per_second`): the
+    first counts the agent's ``predict`` and the env's ``step`` (resets included), the second the env's
+    alone, on the same path, timed call by call in the same loop. Their ratio is ``eval_over_observed``: the
+    share of the observed env's speed an evaluation keeps (1 for an agent that costs nothing)."""
     import time
 
     from digslam.agents.evaluation.evaluate import make_env
 
     env = make_env(env_id, steps + 1, {**SUITE_KWARGS, **dict(env_kwargs or {})})
-    fixed = np.array([0.6, 0.2], np.float32)
-
-    def act(obs: Any) -> np.ndarray:
-        return fixed if policy is None else np.asarray(policy.predict(obs)[0], np.float32)
-
+    clock = time.perf_counter
     try:
-        if policy is not None and hasattr(policy, "reset") and not hasattr(policy, "policy"):
+        if hasattr(policy, "reset") and callable(policy.reset) and not hasattr(policy, "policy"):
             policy.reset()
         obs, _ = env.reset(seed=seed)
-        obs = env.step(act(obs))[0]
-        t0 = time.perf_counter()
+        obs = env.step(np.asarray(policy.predict(obs)[0], np.float32))[0]
+        t_agent = t_env = 0.0
         for _ in range(steps):
-            obs, _, terminated, truncated, _ = env.step(act(obs))
+            t0 = clock()
+            action = np.asarray(policy.predict(obs)[0], np.float32)
+            t1 = clock()
+            obs, _, terminated, truncated, _ = env.step(action)
             if terminated or truncated:
                 seed += 1
                 obs, _ = env.reset(seed=seed)
-        return steps / (time.perf_counter() - t0)
+            t_env += clock() - t1
+            t_agent += t1 - t0
+        return steps / (t_agent + t_env), steps / t_env
     finally:
         env.close()
 
@@ -354,6 +362,7 @@ __all__ = [
     "SUITE_KWARGS",
     "SuiteResult",
     "check_generators",
+    "eval_rates",
     "merge",
     "merge_agents",
     "run_suite",
