@@ -77,13 +77,13 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "warmup",
-        help="compile the numba kernels once (about 2 minutes on 2 cores)",
+        help="compile the numba kernels once (about 50 s on 2 cores)",
         description="Compile the numba kernels of the environments, the observer and the "
         "interval library into their on-disk cache, in parallel processes, so that the first "
         "demo, reset or paving does not wait for them. Run it once after installing. Measured on "
-        "2 cores with an empty cache: about 2 minutes (80 s of CPU; the robot job 48 s, the "
-        "observer 106 s, the interval library 69 s, two jobs at a time); with the kernels cached "
-        "it only loads them (about 7 s).",
+        "2 cores with an empty cache: 50 s (75 s of CPU; the robot job 14 s, the interval library "
+        "36 s, the observer 50 s, two jobs at a time); with the kernels cached it only loads them "
+        "(about 4 s).",
     )
     p.add_argument(
         "--jobs", type=int, default=None, help="parallel processes (default: the CPU count, at most 3)"

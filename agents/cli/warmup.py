@@ -8,7 +8,8 @@ work splits into independent jobs, each in its own process so that two cores com
   noise, ground-truth coverage);
 * ``observer``: a certified-coverage environment's reset and one filter update fed without moving the
   robot (the online Dig-SLAM kernels and the observation map), with the shipped policy's settings;
-* ``interval``: the README's five-line paving (forward-backward separator and paver).
+* ``interval``: the README's five-line paving (forward-backward separator and paver) and the
+  forward-backward contractor, each natural and centred (the centred kernels are kernels of their own).
 
 A job that finds its kernels cached only loads them (about a second).
 """
@@ -60,10 +61,15 @@ def _observer() -> None:
 
 
 def _interval() -> None:
-    from digslam.observer import Box, Function, Interval, SepInverse, pave
+    from digslam.observer import Box, CtcFwdBwd, Function, Interval, SepInverse, pave
 
     f = Function(lambda x: (x[0] - 2) ** 2 + (x[1] - 2.5) ** 2)
-    pave(Box([(-1, 5), (-0.5, 5.5)]), SepInverse(f, Interval(1, 2.25)), eps=0.1)
+    box = Box([(-1, 5), (-0.5, 5.5)])
+    pave(box, SepInverse(f, Interval(1, 2.25)), eps=0.1)
+    pave(box, SepInverse(f, Interval(1, 2.25), centred=True), eps=0.5)  # the centred kernels
+    ctc = CtcFwdBwd(f, Interval(1, 2.25))
+    ctc.contract(box.lo[None], box.hi[None])
+    CtcFwdBwd(f, Interval(1, 2.25), centred=True).contract(box.lo[None], box.hi[None])
 
 
 def run_job(name: str) -> None:
@@ -79,8 +85,9 @@ def warmup(jobs: int | None = None, verbose: bool = False) -> int:
         while todo and len(running) < n:
             name = todo.pop(0)
             code = f"from digslam.agents.cli.warmup import run_job; run_job({name!r})"
+            env = {**os.environ, "DIGSLAM_COMPILE_NOTICE": "0"}  # warmup announces itself
             proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.DEVNULL,
-                                    stderr=subprocess.PIPE, text=True)  # fmt: skip
+                                    stderr=subprocess.PIPE, text=True, env=env)  # fmt: skip
             running[name] = (proc, time.perf_counter())
         for name, (proc, t0) in list(running.items()):
             if proc.poll() is None:

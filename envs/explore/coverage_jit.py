@@ -41,7 +41,7 @@ from digslam.observer.core.scalar_jit import njit
 NB = 256
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def pseudo_angle(x: float, y: float) -> float:
     """A strictly increasing function of the bearing of ``(x, y)`` in ``[0, 2 pi)``, with values in ``[0, 4)``
     (the "diamond angle": one division, no libm call; 0 at the origin)."""
@@ -80,7 +80,7 @@ def todo_blocks(todo: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(pad.reshape(nby, BLOCK, nbx, BLOCK).sum(axis=(1, 3)))
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _block_d2(blocks: np.ndarray, bi: int, bj: int, ra: int, rb: int, ca: int, cb: int, xs: np.ndarray,
               ys: np.ndarray, x: float, y: float) -> float:  # fmt: skip
     """``inf`` if block ``(bi, bj)`` has no cell left to cover, else a lower bound of the computed squared
@@ -93,7 +93,7 @@ def _block_d2(blocks: np.ndarray, bi: int, bj: int, ra: int, rb: int, ca: int, c
     return mx * mx + my * my
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _box(i0: int, i1: int, j0: int, j1: int, x: float, y: float, xs: np.ndarray, ys: np.ndarray,
          resx: float, resy: float, xlo: float, xhi: float, ylo: float, yhi: float
          ) -> tuple[int, int, int, int]:  # fmt: skip
@@ -106,7 +106,7 @@ def _box(i0: int, i1: int, j0: int, j1: int, x: float, y: float, xs: np.ndarray,
     return ia, ib, ja, jb
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _any_todo(todo: np.ndarray, blocks: np.ndarray, ia: int, ib: int, ja: int, jb: int, xs: np.ndarray,
               ys: np.ndarray, x: float, y: float, r2b: float) -> bool:  # fmt: skip
     """Whether some cell of ``[ia:ib, ja:jb]`` still to cover lies nearer than ``sqrt(r2b)`` (the computed
@@ -170,7 +170,7 @@ def _scan_todo(todo: np.ndarray, blocks: np.ndarray, seen: np.ndarray, xs: np.nd
     return count
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _lookup(ws: np.ndarray, tab: np.ndarray) -> None:
     """The lookup table of the scans over ``NB`` pseudo-angle bins, from the sorted interval starts ``ws``:
     the interval of the whole bin, or -2 when a bound lies in it (then a binary search decides)."""

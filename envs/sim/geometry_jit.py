@@ -62,7 +62,7 @@ def edge_boxes(edges: np.ndarray) -> np.ndarray:
     )
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def edge_near(bbox: np.ndarray, k: int, x: float, y: float, reach2: float) -> bool:
     """Whether the bounding box ``bbox[k]`` (:func:`edge_boxes`) of edge ``k`` comes within ``sqrt(reach2)``
     of ``(x, y)`` (the pre-filter of the edge loops; ``reach2 = inf`` keeps every edge)."""
@@ -71,7 +71,7 @@ def edge_near(bbox: np.ndarray, k: int, x: float, y: float, reach2: float) -> bo
     return dx * dx + dy * dy <= reach2
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def segment_distance(ax: float, ay: float, dx: float, dy: float) -> float:
     """Distance (float64, not rounded outward) from the origin to the segment ``a + t d``, ``t in [0, 1]``:
     the distance to the foot of the perpendicular, clamped to the segment."""
@@ -147,7 +147,7 @@ def sector_kernel(x: float, y: float, th: float, alpha: np.ndarray, gamma: np.nd
             dist[s], wit[s, 0], wit[s, 1] = _INF, np.nan, np.nan
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _min_dist(x: float, y: float, edges: np.ndarray, bbox: np.ndarray, reach2: float) -> float:
     best = _INF
     for k in range(edges.shape[0]):
@@ -205,7 +205,7 @@ class _ConeBounds(NamedTuple):
     whole: bool
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _edge_cone(edge: _Edge, px: np.ndarray, py: np.ndarray, pn: np.ndarray, pe: np.ndarray, cone: _ConeBounds
                ) -> tuple[float, float]:  # fmt: skip
     """Bounds ``(lower, upper)`` on the distance from the apexes ``p ∓ sh u`` to the nearest point of one

@@ -33,13 +33,13 @@ UNIFORM, ADVERSARIAL, BIASED = 0, 1, 2
 MODEL_CODES = {"uniform": UNIFORM, "adversarial": ADVERSARIAL, "biased": BIASED}
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _pad4(s: float) -> float:
     """``4 * np.spacing(s)`` for ``s >= 0``."""
     return 4.0 * (np.nextafter(s, math.inf) - s)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _one(t: float, b: float, u: float, model: int, bias: float) -> tuple[float, float, float]:
     """``(measured, lo, hi)`` of one truth ``t`` with bound ``b`` from the uniform draw ``u in [-1, 1)``."""
     if model == ADVERSARIAL:
@@ -63,7 +63,7 @@ def noise_kernel(truth: np.ndarray, bound: np.ndarray, u: np.ndarray, model: int
         m[i], lo[i], hi[i] = _one(truth[i], bound[i], u[i], model, bias)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _pad(v: float, tol: float, sign: float) -> float:
     """``v + sign * tol * max(1, |v|)`` (``|v|`` taken as 0 when infinite), the simulator's widening."""
     a = abs(v) if math.isfinite(v) else 0.0

@@ -60,7 +60,7 @@ def axes_in(a: float, b: float) -> tuple[bool, bool, bool, bool]:
     return east, north, west, south
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def sector_box(r: float, a0: float, a1: float, c0: float, s0: float, c1: float, s1: float
                ) -> tuple[float, float, float, float]:  # fmt: skip
     """``(x_lo, x_hi, y_lo, y_hi)``: the bounding box, relative to its apex, of the circular sector of radius

@@ -19,7 +19,7 @@ from digslam.observer.core.scalar_jit import njit
 __all__ = ["window"]
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _count(a: np.ndarray, v: float, strict: bool) -> int:
     """Number of entries of the increasing ``a`` that are ``< v`` (``<= v`` unless ``strict``).
 

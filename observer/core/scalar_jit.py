@@ -38,6 +38,7 @@ from typing import Any
 import numba
 import numpy as np
 
+from digslam.observer.core.cache import install as _install_compile_notice
 from digslam.observer.core.rounding import LIBM_ULPS
 
 __all__ = ["LIBM_ULPS", "njit", "dn", "up", "wdn", "wup", "add_dn", "add_up", "sub_dn", "sub_up",
@@ -45,10 +46,16 @@ __all__ = ["LIBM_ULPS", "njit", "dn", "up", "wdn", "wup", "add_dn", "add_up", "s
            "imul", "isqr", "idiv", "ixdiv", "isqrt", "iexp", "ilog", "ipown", "iabs"]  # fmt: skip
 
 _INF = math.inf
+_install_compile_notice()  # a cold start says once that it compiles (numba cache miss), on stderr
 
 
 def njit(*args: Any, **kwargs: Any) -> Any:
-    """``numba.njit`` with this project's settings: cached on disk, no fastmath, GIL released."""
+    """``numba.njit`` with this project's settings: cached on disk, no fastmath, GIL released.
+
+    Small helpers take ``forceinline=True``: LLVM inlines them into their callers (its ``alwaysinline``),
+    as fast as numba's ``inline="always"``, which inlines at the level of numba's IR and retypes the
+    helper at every call site (compile time superlinear in the nesting: minutes for the tape kernels).
+    A few leaves that divide keep ``inline="always"``, so that they take their caller's error model."""
     kwargs.setdefault("cache", True)
     kwargs.setdefault("nogil", True)
     kwargs.setdefault("fastmath", False)
@@ -62,21 +69,21 @@ def njit(*args: Any, **kwargs: Any) -> Any:
 _PHI, _NEAR = 2.0**-53 * (1.0 + 2.0**-52), 2.0**-960
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def dn(x: float) -> float:
     """The float below ``x``: a lower bound of any real whose round-to-nearest is ``x``."""
     a = abs(x)
     return x - a * _PHI if _NEAR <= a < _INF else np.nextafter(x, -_INF)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def up(x: float) -> float:
     """The float above ``x``: an upper bound of any real whose round-to-nearest is ``x``."""
     a = abs(x)
     return x + a * _PHI if _NEAR <= a < _INF else np.nextafter(x, _INF)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def wdn(x: float) -> float:
     """``x`` moved down by ``LIBM_ULPS`` ulps: a lower bound of a libm result's exact value."""
     for _ in range(LIBM_ULPS):
@@ -84,7 +91,7 @@ def wdn(x: float) -> float:
     return x
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def wup(x: float) -> float:
     """``x`` moved up by ``LIBM_ULPS`` ulps."""
     for _ in range(LIBM_ULPS):
@@ -92,40 +99,40 @@ def wup(x: float) -> float:
     return x
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _sum_err(a: float, b: float, s: float) -> float:
     """TwoSum (Knuth): the exact ``a + b - s`` (NaN when an operand is infinite)."""
     t = s - a
     return (a - (s - t)) + (b - t)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def add_dn(a: float, b: float) -> float:
     """Lower bound of ``a + b``: exact sums stay exact (TwoSum), others step one ulp down."""
     s = a + b
     return s if _sum_err(a, b, s) >= 0.0 else dn(s)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def add_up(a: float, b: float) -> float:
     """Upper bound of ``a + b``."""
     s = a + b
     return s if _sum_err(a, b, s) <= 0.0 else up(s)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def sub_dn(a: float, b: float) -> float:
     """Lower bound of ``a - b``."""
     return add_dn(a, -b)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def sub_up(a: float, b: float) -> float:
     """Upper bound of ``a - b``."""
     return add_up(a, -b)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def mul_dn(a: float, b: float) -> float:
     """Lower bound of ``a * b``, with ``0 * inf = 0`` (interval convention)."""
     if a == 0.0 or b == 0.0:
@@ -133,7 +140,7 @@ def mul_dn(a: float, b: float) -> float:
     return dn(a * b)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def mul_up(a: float, b: float) -> float:
     """Upper bound of ``a * b``, with ``0 * inf = 0``."""
     if a == 0.0 or b == 0.0:
@@ -153,28 +160,28 @@ def div_up(a: float, b: float) -> float:
     return up(a / b)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def sqrt_dn(a: float) -> float:
     """Lower bound of ``sqrt(a)`` for ``a >= 0`` (never below 0)."""
     r = math.sqrt(a)
     return r if r == 0.0 else dn(r)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def sqrt_up(a: float) -> float:
     """Upper bound of ``sqrt(a)`` for ``a >= 0`` (exact for 0)."""
     r = math.sqrt(a)
     return r if r == 0.0 else up(r)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def nil(al: float, ah: float) -> bool:
     """Whether ``[al, ah]`` holds no real: empty (``al > ah``) or an infinite point (``al = +∞`` or
     ``ah = -∞``; IEEE 1788: ``±∞`` is no real number, so an operation with it is empty)."""
     return al > ah or al == _INF or ah == -_INF
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def imul(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     """``[a] * [b]`` (Eq. 2.6); empty in, empty out."""
     if nil(al, ah) or nil(bl, bh):
@@ -184,7 +191,7 @@ def imul(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     return lo, hi
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def isqr(al: float, ah: float) -> tuple[float, float]:
     """``[a]²``, tighter than ``[a] * [a]`` when ``0 ∈ [a]``."""
     if nil(al, ah):
@@ -197,7 +204,7 @@ def isqr(al: float, ah: float) -> tuple[float, float]:
     return 0.0, mul_up(m, m)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def idiv(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     """``[a] / [b]`` (Eq. 2.7); the whole line when ``0 ∈ [b]`` (a hull, never wrong)."""
     if nil(al, ah) or nil(bl, bh):
@@ -211,7 +218,7 @@ def idiv(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     return lo, hi
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def isqrt(al: float, ah: float) -> tuple[float, float]:
     """``sqrt([a] ∩ [0, ∞))``; empty when ``[a] < 0``."""
     if nil(al, ah) or ah < 0.0:
@@ -219,24 +226,24 @@ def isqrt(al: float, ah: float) -> tuple[float, float]:
     return sqrt_dn(max(al, 0.0)), sqrt_up(ah)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def meet(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     """``[a] ∩ [b]`` (Eq. 2.3)."""
     lo, hi = max(al, bl), min(ah, bh)
     return (lo, hi) if lo <= hi and lo < _INF and hi > -_INF else (_INF, -_INF)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _nan_lo(x: float) -> float:
     return -_INF if x != x else x
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _nan_hi(x: float) -> float:
     return _INF if x != x else x
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def iadd(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     """``[a] + [b]`` (Eq. 2.5)."""
     if nil(al, ah) or nil(bl, bh):
@@ -244,7 +251,7 @@ def iadd(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     return _nan_lo(add_dn(al, bl)), _nan_hi(add_up(ah, bh))
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def isub(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     """``[a] - [b]``."""
     if nil(al, ah) or nil(bl, bh):
@@ -342,7 +349,7 @@ def ipown(al: float, ah: float, n: int) -> tuple[float, float]:
     return lo, hi
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def iabs(al: float, ah: float) -> tuple[float, float]:
     """``|[a]|``."""
     if nil(al, ah):

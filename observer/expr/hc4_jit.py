@@ -206,7 +206,9 @@ def _contract(code: np.ndarray, outs: np.ndarray, v: np.ndarray, w: np.ndarray, 
               y: np.ndarray, j0: int, per_box: bool) -> None:  # fmt: skip
     """``w = v``, outputs met with ``[y]`` (``y (2, m)``, or ``(2, N, m)`` when ``per_box``; only output
     ``j0`` when ``j0 >= 0``), then the backward pass."""
-    w[:] = v
+    for k in range(w.shape[1]):  # element by element: an array copy would compile numba's shape check
+        for r in range(w.shape[2]):
+            w[0, k, r], w[1, k, r] = v[0, k, r], v[1, k, r]
     for r in range(w.shape[2]):
         alive[r] = True
     for j in range(outs.shape[0]):
@@ -237,17 +239,13 @@ def _store(code: np.ndarray, lo: np.ndarray, hi: np.ndarray, w: np.ndarray, aliv
 
 
 @njit(**_KW)
-def _sep_box_kernel(code: np.ndarray, cst: np.ndarray, outs: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                    y: np.ndarray, centred: bool, mid: np.ndarray) -> np.ndarray:  # fmt: skip
-    """``(4, N, n)``: ``in_lo, in_hi, out_lo, out_hi`` of the separator of ``f⁻¹([y])``, ``y (2, 1, m)``;
-    with ``centred`` the outputs' natural enclosures are met with the mean-value form (centres ``mid``)."""
-    v = np.empty((2, code.shape[0], lo.shape[0]))
+def _separate(code: np.ndarray, outs: np.ndarray, lo: np.ndarray, hi: np.ndarray, y: np.ndarray,
+              v: np.ndarray) -> np.ndarray:  # fmt: skip
+    """``(4, N, n)``: ``in_lo, in_hi, out_lo, out_hi`` of the separator of ``f⁻¹([y])``, ``y (2, 1, m)``,
+    from the node enclosures ``v`` of a forward pass."""
     w, alive = np.empty_like(v), np.empty(lo.shape[0], dtype=np.bool_)
     res = np.empty((4, lo.shape[0], lo.shape[1]))
     res[0::2], res[1::2] = _INF, -_INF
-    _forward(code, cst, lo, hi, v)
-    if centred:
-        centre_outputs(code, cst, outs, lo, hi, mid, v)
     _contract(code, outs, v, w, alive, y, -1, False)
     _store(code, lo, hi, w, alive, res, 2, False)
     half = np.empty_like(y)
@@ -267,22 +265,56 @@ def _sep_box_kernel(code: np.ndarray, cst: np.ndarray, outs: np.ndarray, lo: np.
                 for i in range(lo.shape[1]):
                     nonempty = nonempty and lo[r, i] <= hi[r, i]
                 if nonempty:
-                    res[0, r], res[1, r] = lo[r], hi[r]
+                    for i in range(lo.shape[1]):
+                        res[0, r, i], res[1, r, i] = lo[r, i], hi[r, i]
     return res
 
 
 @njit(**_KW)
+def _sep_box_kernel(code: np.ndarray, cst: np.ndarray, outs: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                    y: np.ndarray) -> np.ndarray:  # fmt: skip
+    """:func:`_separate` after the natural forward pass."""
+    v = np.empty((2, code.shape[0], lo.shape[0]))
+    _forward(code, cst, lo, hi, v)
+    return _separate(code, outs, lo, hi, y, v)
+
+
+@njit(**_KW)
+def _sep_box_centred_kernel(code: np.ndarray, cst: np.ndarray, outs: np.ndarray, lo: np.ndarray,
+                            hi: np.ndarray, y: np.ndarray, mid: np.ndarray) -> np.ndarray:  # fmt: skip
+    """:func:`_separate` after the forward pass, its outputs met with the mean-value form (centres
+    ``mid``); a kernel of its own, so that the natural one does not compile the centred form."""
+    v = np.empty((2, code.shape[0], lo.shape[0]))
+    _forward(code, cst, lo, hi, v)
+    centre_outputs(code, cst, outs, lo, hi, mid, v)
+    return _separate(code, outs, lo, hi, y, v)
+
+
+@njit(**_KW)
 def _hc4_kernel(code: np.ndarray, cst: np.ndarray, outs: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                y: np.ndarray, centred: bool, mid: np.ndarray) -> np.ndarray:  # fmt: skip
-    """``(2, N, n)``: HC4-revise of ``f(x_r) ∈ [y_r]`` for every row, ``y (2, N, m)`` (outputs met with
-    the mean-value form first when ``centred``)."""
+                y: np.ndarray) -> np.ndarray:  # fmt: skip
+    """``(2, N, n)``: HC4-revise of ``f(x_r) ∈ [y_r]`` for every row, ``y (2, N, m)``."""
     v = np.empty((2, code.shape[0], lo.shape[0]))
     w, alive = np.empty_like(v), np.empty(lo.shape[0], dtype=np.bool_)
     res = np.empty((2, lo.shape[0], lo.shape[1]))
     res[0], res[1] = _INF, -_INF
     _forward(code, cst, lo, hi, v)
-    if centred:
-        centre_outputs(code, cst, outs, lo, hi, mid, v)
+    _contract(code, outs, v, w, alive, y, -1, True)
+    _store(code, lo, hi, w, alive, res, 0, False)
+    return res
+
+
+@njit(**_KW)
+def _hc4_centred_kernel(code: np.ndarray, cst: np.ndarray, outs: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                        y: np.ndarray, mid: np.ndarray) -> np.ndarray:  # fmt: skip
+    """As :func:`_hc4_kernel`, the outputs met with the mean-value form (centres ``mid``) first; a kernel
+    of its own, so that the natural one does not compile the centred form."""
+    v = np.empty((2, code.shape[0], lo.shape[0]))
+    w, alive = np.empty_like(v), np.empty(lo.shape[0], dtype=np.bool_)
+    res = np.empty((2, lo.shape[0], lo.shape[1]))
+    res[0], res[1] = _INF, -_INF
+    _forward(code, cst, lo, hi, v)
+    centre_outputs(code, cst, outs, lo, hi, mid, v)
     _contract(code, outs, v, w, alive, y, -1, True)
     _store(code, lo, hi, w, alive, res, 0, False)
     return res
@@ -296,7 +328,8 @@ def _image_kernel(code: np.ndarray, cst: np.ndarray, outs: np.ndarray, lo: np.nd
     _forward(code, cst, lo, hi, v)
     res = np.empty((2, lo.shape[0], outs.shape[0]))
     for j in range(outs.shape[0]):
-        res[0, :, j], res[1, :, j] = v[0, outs[j]], v[1, outs[j]]
+        for r in range(lo.shape[0]):
+            res[0, r, j], res[1, r, j] = v[0, outs[j], r], v[1, outs[j], r]
     return res
 
 
@@ -321,8 +354,16 @@ def image(t: Tape, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return res[0], res[1]
 
 
-def _mid(lo: np.ndarray, hi: np.ndarray, centred: bool) -> np.ndarray:
-    return centres(lo, hi) if centred else np.zeros((1, lo.shape[1]))
+def _run_hc4(t: Tape, lo: np.ndarray, hi: np.ndarray, y: np.ndarray, centred: bool) -> np.ndarray:
+    if centred:
+        return _hc4_centred_kernel(t.code, t.cst, t.outputs, lo, hi, y, centres(lo, hi))
+    return _hc4_kernel(t.code, t.cst, t.outputs, lo, hi, y)
+
+
+def _run_sep(t: Tape, lo: np.ndarray, hi: np.ndarray, y: np.ndarray, centred: bool) -> np.ndarray:
+    if centred:
+        return _sep_box_centred_kernel(t.code, t.cst, t.outputs, lo, hi, y, centres(lo, hi))
+    return _sep_box_kernel(t.code, t.cst, t.outputs, lo, hi, y)
 
 
 def hc4(t: Tape, lo: np.ndarray, hi: np.ndarray, ylo: np.ndarray, yhi: np.ndarray,
@@ -334,13 +375,12 @@ def hc4(t: Tape, lo: np.ndarray, hi: np.ndarray, ylo: np.ndarray, yhi: np.ndarra
     y = np.stack([np.broadcast_to(ylo, shape), np.broadcast_to(yhi, shape)]).astype(np.float64)
     lo, hi = _c(lo), _c(hi)
     if lo.shape[0] <= BLOCK:
-        res = _hc4_kernel(t.code, t.cst, t.outputs, lo, hi, y, centred, _mid(lo, hi, centred))
+        res = _run_hc4(t, lo, hi, y, centred)
         return res[0], res[1]
     res = np.empty((2, *lo.shape))
     for i in range(0, lo.shape[0], BLOCK):
         b = slice(i, i + BLOCK)
-        yb, mid = np.ascontiguousarray(y[:, b]), _mid(lo[b], hi[b], centred)
-        res[:, b] = _hc4_kernel(t.code, t.cst, t.outputs, lo[b], hi[b], yb, centred, mid)
+        res[:, b] = _run_hc4(t, lo[b], hi[b], np.ascontiguousarray(y[:, b]), centred)
     return res[0], res[1]
 
 
@@ -348,12 +388,11 @@ def sep_box(t: Tape, lo: np.ndarray, hi: np.ndarray, y: np.ndarray, centred: boo
     """``(4, N, n)``: ``x_in`` (lo, hi) then ``x_out`` of the separator of ``f⁻¹([y])``, ``y (2, m)``."""
     lo, hi, yy = _c(lo), _c(hi), _c(y)[:, None, :]
     if lo.shape[0] <= BLOCK:
-        return _sep_box_kernel(t.code, t.cst, t.outputs, lo, hi, yy, centred, _mid(lo, hi, centred))
+        return _run_sep(t, lo, hi, yy, centred)
     res = np.empty((4, *lo.shape))
     for i in range(0, lo.shape[0], BLOCK):
         b = slice(i, i + BLOCK)
-        mid = _mid(lo[b], hi[b], centred)
-        res[:, b] = _sep_box_kernel(t.code, t.cst, t.outputs, lo[b], hi[b], yy, centred, mid)
+        res[:, b] = _run_sep(t, lo[b], hi[b], yy, centred)
     return res
 
 

@@ -71,7 +71,7 @@ class Tape:
         return Tape(code, cst, np.asarray(f.outputs, dtype=np.int64), f.n)
 
 
-@njit(inline="always", error_model="numpy")
+@njit(forceinline=True, error_model="numpy")
 def fwd_op(op: int, al: float, ah: float, bl: float, bh: float, p: int) -> tuple[float, float]:
     """Natural inclusion (Eq. 2.21) of one tape node ``op`` from its arguments' enclosures."""
     if op == ADD:

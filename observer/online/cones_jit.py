@@ -56,7 +56,7 @@ _TWO_PI = 2.0 * math.pi
 MIN_SLICE = 0.02
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _wrap(a: float) -> float:
     """``a`` in about ``[-π, π)`` (the rounding is covered by :data:`ANGLE_PAD`)."""
     return a - _TWO_PI * math.floor((a + math.pi) / _TWO_PI)
@@ -90,7 +90,7 @@ def box_in_cone(cx0: float, cy0: float, cx1: float, cy1: float, gx0: float, gy0:
     return gap <= half + 0.5 * (hi - lo) + 2.0 * ANGLE_PAD
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _outside(cx0: float, cy0: float, cx1: float, cy1: float, gx0: float, gy0: float, gx1: float, gy1: float,
              hp: np.ndarray) -> bool:  # fmt: skip
     """Whether the difference box ``G - C`` lies wholly on the outer side of one of the half-planes

@@ -214,7 +214,7 @@ class StepRecord(NamedTuple):
     mean_velocity: np.ndarray = NO_MEAN
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def cell_size(grid: GridFrame) -> tuple[float, float]:
     """The cell size ``(dx, dy)`` of ``grid``: its frame's sides over the numbers of columns and rows, which
     is ``Grid.cell_size`` to the bit (the same two operations on the same floats)."""
@@ -222,21 +222,21 @@ def cell_size(grid: GridFrame) -> tuple[float, float]:
     return (xs[xs.size - 1] - xs[0]) / (xs.size - 1), (ys[0] - ys[ys.size - 1]) / (ys.size - 1)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def in_frame(grid: GridFrame, x0: float, y0: float, x1: float, y1: float) -> bool:
     """Whether the box ``[x0, x1] × [y0, y1]`` is non-empty and lies in the frame of ``grid``."""
     xs, ys = grid.xs, grid.ys
     return xs[0] <= x0 <= x1 <= xs[xs.size - 1] and ys[ys.size - 1] <= y0 <= y1 <= ys[0]
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def prod_lo(al: float, ah: float, bl: float, bh: float) -> float:
     """Lower bound of ``[a]·[b]`` (finite bounds): each product is within half an ulp, so one
     :func:`~digslam.observer.core.scalar_jit.dn` step of the smallest bounds them all."""
     return dn(min(al * bl, al * bh, ah * bl, ah * bh))
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def prod_hi(al: float, ah: float, bl: float, bh: float) -> float:
     """Upper bound of ``[a]·[b]`` (finite bounds): one :func:`~digslam.observer.core.scalar_jit.up` step of
     the largest product."""
@@ -251,7 +251,7 @@ def edge_direction(t: float) -> tuple[float, float, float, float]:
     return wdn(c), wup(c), wdn(s), wup(s)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def box_ok(box: PoseBox) -> bool:
     """Whether the position box of ``box`` is non-empty and finite."""
     x0, y0, x1, y1 = box.x_lo, box.y_lo, box.x_hi, box.y_hi
@@ -396,7 +396,7 @@ def dig_reading(cells: CellSets, grid: GridFrame, box: PoseBox, alpha: float, ga
     return _dig_cone(cells, grid, box, t1, t2, r, False, axes, sid)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def union(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> tuple[int, int, int, int]:
     """Smallest window ``(r0, r1, c0, c1)`` holding the windows ``a`` and ``b`` (empty: ``r0 >= r1`` or
     ``c0 >= c1``)."""

@@ -48,7 +48,7 @@ __all__ = [
 TRIG_PAD = 2e-15
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _mul(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     """Outward-rounded product of two finite intervals (:func:`.dig_jit.prod_lo`,
     :func:`.dig_jit.prod_hi`)."""

@@ -21,7 +21,7 @@ from digslam.observer.core.scalar_jit import njit
 __all__ = ["pave_generation"]
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _diff(lo: np.ndarray, hi: np.ndarray, r: int, y: np.ndarray, out: np.ndarray, rows: np.ndarray,
           c: int) -> int:  # fmt: skip
     """Write the closed pieces of ``[x_r] \\ [y]`` (``[y] ⊂ [x_r]``; ``y = (2, n)``) from slot ``c``, as
@@ -48,7 +48,7 @@ def _diff(lo: np.ndarray, hi: np.ndarray, r: int, y: np.ndarray, out: np.ndarray
     return c
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _meet_row(lo: np.ndarray, hi: np.ndarray, r: int, a: np.ndarray, j: int, y: np.ndarray) -> None:
     """``y = [a_r] ∩ [x_r]`` (``a`` is ``x_in`` for ``j = 0``, ``x_out`` for ``j = 2``); empty as
     ``[+inf, -inf]``."""
@@ -110,7 +110,7 @@ def pave_generation(lo: np.ndarray, hi: np.ndarray, sep: np.ndarray, eps: float,
     return out, rows + base, left, cnt - off
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _cut(lo_k: float, hi_k: float, w: float, eps: float, ratio: float, grid: bool) -> float:
     """Where to cut the side ``[lo_k, hi_k]`` (rounded-up width ``w``): at ``ratio``, or (``grid`` and
     ``w >= eps``) at the boundary nearest the middle of ``⌊w / eps⌋ + 1`` equal cells."""

@@ -29,7 +29,9 @@ def fold_separated(acc: np.ndarray, s: np.ndarray, lo: np.ndarray, hi: np.ndarra
     if acc.shape[0] == 0:
         acc = np.empty((4, nb, n))
         acc[h], acc[h + 1] = np.inf, -np.inf
-        acc[m], acc[m + 1] = lo, hi
+        for r in range(nb):  # element by element: an array copy would compile numba's shape check
+            for i in range(n):
+                acc[m, r, i], acc[m + 1, r, i] = lo[r, i], hi[r, i]
     for r in range(nb):
         empty = False
         for i in range(n):

@@ -30,7 +30,9 @@ SCRIPTS = sorted(p.stem for p in BENCHMARKS.glob("bench_*.py"))
 KEYS: dict[str, tuple[str, ...]] = {
     name: tuple(keys.split())
     for name, keys in {
-        "bench_agents": "best_heuristic heuristic_level_success eval_steps_per_s",
+        "bench_agents": "target_levels best_heuristic heuristic_level_success eval_steps_per_s eval_over_observed",
+        "bench_cold_start": "cold_first_contract_s warm_first_contract_s cold_over_warm_contract",
+        "bench_levels": "target_levels shipped_levels levels_match",
         "bench_digslam": "seconds",
         "bench_env": "ours_steps_per_s ours_unwrapped_steps_per_s ours_steps_per_s_unicycle hard_stops "
         "reference_steps_per_s ratio_vs_raycast_unicycle ratio_vs_raycast",
@@ -49,7 +51,7 @@ KEYS: dict[str, tuple[str, ...]] = {
 #: Too slow for the default run even with ``--quick`` (warm numba cache, CPU time): bench_agents plays every
 #: agent on the suite's generators and measures the step rate (about 28 s), bench_teacher the look-ahead
 #: teachers on two workers (about 42 s).
-EXPENSIVE = {"bench_agents", "bench_teacher"}
+EXPENSIVE = {"bench_agents", "bench_cold_start", "bench_teacher"}  # bench_cold_start compiles cold by design
 
 #: A ``key=value`` token: at the start of a line or after a blank (``a=1 b=2`` holds two).
 _KEY = re.compile(r"(?:^|\s)([A-Za-z_]\w*)=(\S+)")

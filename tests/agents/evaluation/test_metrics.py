@@ -63,7 +63,9 @@ def test_summaries_and_the_table() -> None:
     assert per["T80"].tolist() == [1.0, 3.0] and per["T95"].tolist() == [3.0, 3.0]
     assert per["S95"].tolist() == [1.0, 0.0] and per["collisions"].tolist() == [0.0, 2.0]
     row = metrics_table(res.metrics()).splitlines()[2]
-    assert row.startswith("| a | 2 / 2 (100%) | 2 / 2 (50%) | 2 / 2 (50%) | 3 / 3 (50%) |") and "n/a" in row  # T80, T85, T90, T95
+    assert (
+        row.startswith("| a | 2 / 2 (100%) | 2 / 2 (50%) | 2 / 2 (50%) | 3 / 3 (50%) |") and "n/a" in row
+    )  # T80, T85, T90, T95
 
 
 def test_the_paired_bootstrap_interval_holds_the_true_ratio_and_is_deterministic() -> None:

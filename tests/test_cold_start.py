@@ -1,0 +1,111 @@
+"""The cold-start notice (:func:`digslam.observer.core.cache.install`) and the cold README example."""
+
+from __future__ import annotations
+
+import io
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numba
+import pytest
+from numba.core import event
+
+from digslam.observer.core import cache
+from digslam.observer.core.cache import Notice, install, kind_of, message
+
+
+def _compiled_in(module: str) -> numba.core.registry.CPUDispatcher:
+    """A new (uncached) numba function whose ``__module__`` is ``module``."""
+    scope: dict = {"__name__": module}
+    exec("def twice(x):\n    return 2 * x\n", scope)
+    return numba.njit(cache=False)(scope["twice"])
+
+
+def test_notice_prints_once_and_only_for_digslam(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("DIGSLAM_COMPILE_NOTICE", "1")  # shown although the stream is no terminal
+    out = io.StringIO()
+    notice = Notice(out)
+    listener = install(notice)
+    try:
+        _compiled_in("user_code")(1)  # someone else's kernel: no notice
+        assert out.getvalue() == ""
+        f = _compiled_in("digslam.observer.fake_jit")
+        f(1)  # compiles: the notice
+        f(2)  # compiled already: no event
+        f(2.5)  # a new signature compiles again, but the notice is shown once per process
+        _compiled_in("digslam.envs.fake_jit")(3)
+    finally:
+        event.unregister("numba:compile", listener)
+    assert out.getvalue() == message("interval") + "\n"
+
+
+def test_notice_kinds_and_switch(monkeypatch: pytest.MonkeyPatch) -> None:
+    assert kind_of("digslam.observer.expr.hc4_jit") == "interval"
+    assert kind_of("digslam.observer.online.dig_jit") == "env"
+    assert kind_of("digslam.envs.sim.geometry_jit") == "env"
+    assert kind_of("numba.np.arrayobj") is None
+    env_line = message("env")
+    assert "digslam warmup" in env_line and f"about {cache.ESTIMATES['env']} s" in env_line
+    out = io.StringIO()
+    for switch in ("0", ""):  # off; unset, and the stream is no terminal (a pipe, a log, pytest's capture)
+        monkeypatch.setenv("DIGSLAM_COMPILE_NOTICE", switch)
+        assert not Notice(out).compiling("digslam.observer.x") and out.getvalue() == ""
+    monkeypatch.setenv("DIGSLAM_COMPILE_NOTICE", "1")
+    notice = Notice(out)
+    assert not notice.compiling("numba.np.arrayobj") and out.getvalue() == ""
+    assert notice.compiling("digslam.observer.x") and not notice.compiling("digslam.observer.x")
+    assert out.getvalue() == message("interval") + "\n"
+
+
+def test_the_process_notice_is_installed_once() -> None:
+    import digslam.observer  # noqa: F401 - importing the kernels installs it
+
+    assert cache._installed and install() is cache._installed[0]
+
+
+README = """
+from digslam.observer import Box, Function, Interval, SepInverse, pave
+
+f = Function(lambda x: (x[0] - 2) ** 2 + (x[1] - 2.5) ** 2)
+ring = SepInverse(f, Interval(1, 2.25))
+p = pave(Box([(-1, 5), (-0.5, 5.5)]), ring, eps=0.001)
+print(p)
+"""
+
+
+def _readme_cold_then_warm() -> tuple[tuple[float, str], tuple[float, str]]:
+    """``(seconds, stderr)`` of the README example in a fresh process with an empty numba cache, then
+    again with that cache filled."""
+    with tempfile.TemporaryDirectory() as folder:
+        # the guard's stamp, so that it does not clear the shared caches of the source tree
+        Path(folder, cache.STAMP).write_text(cache.digest(cache.kernel_sources()) + "\n")
+        env = {**os.environ, "NUMBA_CACHE_DIR": folder, "DIGSLAM_COMPILE_NOTICE": "1"}  # stderr is a pipe
+        runs = []
+        for _ in range(2):
+            t0 = time.perf_counter()
+            proc = subprocess.run([sys.executable, "-c", README], env=env, cwd=folder, capture_output=True,
+                                  text=True, check=True)  # fmt: skip
+            runs.append((time.perf_counter() - t0, proc.stderr))
+    return runs[0], runs[1]
+
+
+@pytest.mark.expensive
+def test_cold_readme_example_announces_compilation_once() -> None:
+    """A cold start says once that it compiles; a warm one (numba cache hit) says nothing."""
+    (_, cold_err), (_, warm_err) = _readme_cold_then_warm()
+    notice = "digslam: compiling kernels, first run only"
+    assert cold_err.count(notice) == 1 and notice not in warm_err
+
+
+@pytest.mark.expensive
+@pytest.mark.xfail(reason="issue #38 goal not met yet: the kernels compile in about 8 s of CPU, the warm run "
+                   "takes about 1.5 s (cold ~7x warm on 2 cores); needs kernels compiled at install time",
+                   strict=False)  # fmt: skip
+def test_cold_readme_example_within_three_times_warm() -> None:
+    """With an empty numba cache the README's five lines answer within 3x their warm time."""
+    (cold, _), (warm, _) = _readme_cold_then_warm()
+    assert cold <= 3 * warm, f"cold {cold:.1f} s, warm {warm:.1f} s"
