@@ -127,12 +127,5 @@ class DistanceAdvantageAgent(TourFrontierAgent):
 
     def stop_lengths(self, view: View, mem: Memory, reach: np.ndarray, pix: np.ndarray) -> np.ndarray:
         """``(K, m, m)`` path lengths from each stop pixel of ``pix (K, 2)`` over the planner's graph."""
-        if self.soft:  # the planner's own graph (NavigatingAgent._plan)
-            eroded = self.traversable(view) & ~mem.blocked
-            weight = self.weights(view, eroded)
-            weight[mem.blocked] = np.inf
-            trav = np.isfinite(weight)
-            lengths = pl.path_lengths(trav, pix, np.where(trav, weight, 1.0))
-        else:
-            lengths = pl.path_lengths(reach & ~mem.blocked, pix)
-        return lengths
+        free, weight = self.planner_graph(view, mem, reach)
+        return pl.path_lengths(free, pix, weight)

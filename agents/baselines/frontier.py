@@ -254,6 +254,19 @@ class NavigatingAgent(BaselinePolicy):
             j += 1  # a waypoint that _drive counts as reached at once would stop the robot for good
         mem.waypoint = path[j].astype(np.float64) + 0.5
 
+    def planner_graph(
+        self, view: View, mem: Memory, reach: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray | None]:
+        """``(free, weight)`` of the graph :meth:`_plan` searches, for path lengths between other pixels
+        (:func:`.planning.path_lengths`): the soft planner's pixels not dark and not blocked with their costs
+        (:meth:`weights`), or the plain planner's reachable pixels not blocked, unweighted."""
+        if not self.soft:
+            return reach & ~mem.blocked, None
+        weight = self.weights(view, self.traversable(view) & ~mem.blocked)
+        weight[mem.blocked] = np.inf
+        free = np.isfinite(weight)
+        return free, np.where(free, weight, 1.0)
+
     def weights(self, view: View, eroded: np.ndarray | None = None) -> np.ndarray:
         """``(m, m)`` cost per pixel of the soft planner: 1 on the traversable pixels (clear, eroded; pass
         them as ``eroded`` if already computed), ``edge_weight`` on the other clear pixels,

@@ -133,14 +133,8 @@ class TourFrontierAgent(FrontierAgent):
         pix, masks = self.stops(view, mem, reach, cost)
         if len(masks) < 2:
             return
-        if self.soft:  # the planner's own graph (NavigatingAgent._plan)
-            eroded = self.traversable(view) & ~mem.blocked
-            weight = self.weights(view, eroded)
-            weight[mem.blocked] = np.inf
-            trav = np.isfinite(weight)
-            d = pl.pair_lengths(trav, pix, np.where(trav, weight, 1.0))
-        else:
-            d = pl.pair_lengths(reach & ~mem.blocked, pix)
+        free, weight = self.planner_graph(view, mem, reach)
+        d = pl.pair_lengths(free, pix, weight)
         regret = tour_regret(d)
         for mask, r in zip(masks, regret, strict=True):
             cost[mask] += self.tour_weight * r

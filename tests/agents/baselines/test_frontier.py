@@ -62,7 +62,7 @@ def test_a_closure_keeps_going_while_targets_remain() -> None:
 
 
 @pytest.mark.parametrize("world", sorted(set(GENERATORS) - {"file"}))
-@pytest.mark.parametrize("name", ["frontier", "uncertainty_frontier", "tour_frontier"])
+@pytest.mark.parametrize("name", ["frontier", "uncertainty_frontier", "tour_frontier", "distance_advantage"])
 def test_the_frontier_agents_run_a_full_short_episode_on_every_generator(world: str, name: str) -> None:
     env = gym.make("digslam/DigCoverage-v0", world=world, map_size=36, max_episode_steps=150)
     agent = make_baseline(name, env, seed=0)
