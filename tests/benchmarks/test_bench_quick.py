@@ -30,9 +30,9 @@ SCRIPTS = sorted(p.stem for p in BENCHMARKS.glob("bench_*.py"))
 KEYS: dict[str, tuple[str, ...]] = {
     name: tuple(keys.split())
     for name, keys in {
-        "bench_agents": "target_levels best_heuristic heuristic_level_success eval_steps_per_s eval_over_observed",
+        "bench_agents": "best_heuristic heuristic_level_success eval_steps_per_s eval_over_observed",
         "bench_cold_start": "cold_first_contract_s warm_first_contract_s cold_over_warm_contract",
-        "bench_levels": "target_levels shipped_levels levels_match",
+        "bench_levels": "levels_match",
         "bench_digslam": "seconds",
         "bench_env": "ours_steps_per_s ours_unwrapped_steps_per_s ours_steps_per_s_unicycle hard_stops "
         "reference_steps_per_s ratio_vs_raycast_unicycle ratio_vs_raycast",

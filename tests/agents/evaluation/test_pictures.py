@@ -57,7 +57,7 @@ def first_frame():  # type: ignore[no-untyped-def]
     _, info = env.reset(seed=0)
     drawer = pictures.FrameDrawer(pictures._observer_layer(env), "t", info.get("target"), 10)
     img = drawer.frame(info, 0)
-    img.putpalette(frames._flat_palette())  # as write_gif does
+    img.putpalette(frames.flat_palette())  # as write_gif does
     rgb = np.asarray(img.convert("RGB"))
     env.close()
     return drawer, info, rgb
