@@ -13,7 +13,8 @@
   near sensed obstacles, visited while the tube was narrow, and turns there until the tube shrinks (active
   loop closure).
 
-All read only the observation (:mod:`.policy`). :func:`make_baseline` sizes one from an env.
+All read only the observation (:mod:`digslam.agents.baselines.policy`). :func:`make_baseline` sizes one
+from an env.
 
 >>> import gymnasium as gym, digslam.envs
 >>> env = gym.make("digslam/DigCoverage-v0", map_size=36)

@@ -20,13 +20,13 @@ those of the frontier agent. Everything comes from the observation, as for every
 Measured on the validation levels 1 000 000-1 000 011 of each generator (3000 steps, target 1.0; means over
 the 12 levels, frontier agent / tour frontier agent with ``tour_weight`` 2):
 
-========  ===============  ===============  ===============  ===============
-generator T80              T90              AUC              certified 0.9
-========  ===============  ===============  ===============  ===============
-rooms     2555 / 2428      3000 / 2963      0.303 / 0.334    0 % / 8 %
-rocks     1096 / 1151      2297 / 2653      0.540 / 0.538    92 % / 58 %
-caves     365 / 369        665 / 710        0.767 / 0.768    100 % / 100 %
-========  ===============  ===============  ===============  ===============
+=========  ===============  ===============  ===============  ===============
+generator  T80              T90              AUC              certified 0.9
+=========  ===============  ===============  ===============  ===============
+rooms      2555 / 2428      3000 / 2963      0.303 / 0.334    0 % / 8 %
+rocks      1096 / 1151      2297 / 2653      0.540 / 0.538    92 % / 58 %
+caves      365 / 369        665 / 710        0.767 / 0.768    100 % / 100 %
+=========  ===============  ===============  ===============  ===============
 
 The tour pays where frontiers are few and far apart (the rooms' corridors: the last room is less often left
 for the end) and costs where they are many and small (the gaps between rocks: ordering a dozen small

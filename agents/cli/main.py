@@ -8,9 +8,9 @@ subcommand has ``--help``; heavy imports (torch, SB3, matplotlib) happen only wh
 
 :func:`main` is the entry point (also ``python -m digslam.agents.cli.main``); the command line is split over
 :mod:`.parser` (the parser), :mod:`.common` (:class:`UserError`, path and environment checks),
-:mod:`.agents` (``--agent``, saved models), :mod:`.commands`, :mod:`.episodes` and :mod:`.distributed`
-(the subcommands). Their public names are re-exported here. The model registry (the shipped policy, its
-environment) is :mod:`digslam.agents.learning.models`.
+:mod:`digslam.agents.cli.agents` (``--agent``, saved models), :mod:`.commands`, :mod:`.episodes` and
+:mod:`.distributed` (the subcommands). Their public names are re-exported here. The model registry (the
+shipped policy, its environment) is :mod:`digslam.agents.learning.models`.
 
 The console script ``digslam`` is :func:`main` (``digslam.agents.cli.main:main``).
 

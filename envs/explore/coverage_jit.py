@@ -16,7 +16,8 @@ within reach. Same decisions, bit for bit, as the kernel without block skipping 
 except for cell centres within rounding of a cone edge.
 
 Example (one omnidirectional sensor of reach 0.12 at the centre of a 3 x 3 grid of 0.1 m cells; a second
-update from the same pose finds nothing new):
+update from the same pose finds nothing new)::
+
     >>> todo, seen = np.ones((3, 3), dtype=bool), np.zeros((3, 3), dtype=bool)
     >>> xs = ys = np.array([0.05, 0.15, 0.25])
     >>> geo = np.concatenate([[0.0, 0.0, 0.1, 0.1, 2, 2], xs, ys])   # corner, cell sides, reach in cells

@@ -196,6 +196,9 @@ class ExploreEnv(gym.Env):
         return self._obs(record), self._info(record, truth)
 
     def step(self, action: np.ndarray) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        """One step of ``dt`` under the normalised command ``action = (v, omega)`` in ``[-1, 1]²``: the
+        Gymnasium ``(observation, reward, terminated, truncated, info)``, with the step's record and ground
+        truth in ``info``."""
         return self._step(action)
 
     def _step(

@@ -12,7 +12,8 @@ no edge that could block is left out. If the start's clearance exceeds ``radius 
 clear without checking the arc.
 
 Example (1 m/s for 4 substeps of 0.025 s at a wall 0.25 m ahead of a disc of radius 0.2: two substeps
-run, then the disc touches the wall and stops):
+run, then the disc touches the wall and stops)::
+
     >>> import numpy as np
     >>> from digslam.envs.sim.geometry_jit import edge_boxes
     >>> edges, pose, fractions = np.array([[0.25, -1.0, 0.25, 1.0]]), np.zeros(3), np.array([0.5, 0.25])

@@ -28,7 +28,7 @@ from digslam.observer.core import arith
 from digslam.observer.core.types import Pair
 
 #: types an interval operator hands over to (their reflected operator builds the result);
-#: :mod:`.expr` registers its ``Expr`` here
+#: :mod:`digslam.observer.expr.expr` registers its ``Expr`` here
 DEFER_TO: tuple[type, ...] = ()
 
 

@@ -1,4 +1,5 @@
-"""The kernels of the paver (:mod:`.paver`, thesis Algorithm 2.1): one generation of boxes per call.
+"""The kernels of the paver (:mod:`digslam.observer.paving.paver`, thesis Algorithm 2.1): one generation of
+boxes per call.
 
 :func:`pave_generation` takes a generation ``(N, n)`` and its separation ``(4, N, n)`` and writes, in one
 machine-code loop, the inner and outer pieces (the closed pieces of ``[x] \\ [x_in]`` and

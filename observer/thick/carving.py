@@ -153,7 +153,7 @@ def ctc_param_subset(p_box: Any, a: ThickSep, b: ThickSep, f: Any, a_box: Any, e
         a_box: a bounded box for the projection over ``a`` (sound even if it misses part of ``A⁻``:
             fewer constraints, a larger set).
         eps: splitting width of ``a_box``; eps_p: paving width of ``[p]``.
-        presplit: initial bisections of ``[p]``; **proj_kw: ``max_splits``, ``max_pairs``, ``presplit``
+        presplit: initial bisections of ``[p]``; ``**proj_kw``: ``max_splits``, ``max_pairs``, ``presplit``
             (of ``a_box``) or ``q`` for the registration separator.
 
     Returns:

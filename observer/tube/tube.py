@@ -3,8 +3,8 @@
 A tube ``[x](·)`` is an interval of trajectories. Here it is sliced over a time grid
 ``t_0 < ... < t_T``: a gate ``[x](t_k)`` at each grid time and a slice, the envelope of ``[x](τ)`` for
 ``τ ∈ [t_k, t_{k+1}]`` (closed, so a slice holds both of its gates). :func:`ctc_deriv` contracts a tube
-with ``ẋ = u``, ``u ∈ [u]`` (the kernels and the soundness proof are in :mod:`.ctc`), which
-propagates a contraction made at one time (a position fix, a registration) to the whole trajectory.
+with ``ẋ = u``, ``u ∈ [u]`` (the kernels and the soundness proof are in :mod:`digslam.observer.tube.ctc`),
+which propagates a contraction made at one time (a position fix, a registration) to the whole trajectory.
 :func:`heading_from_gyro`, :func:`heading_from_compass`, :func:`unicycle_velocity` and
 :func:`dead_reckoning` build the guaranteed dead reckoning of Eq. 3.59, 6.12, 6.23 and B.20.
 
@@ -222,7 +222,7 @@ def ctc_deriv(x: Tube, u_lo: ArrayLike, u_hi: ArrayLike, forward: bool = True, b
 
     Gates ``x_{k+1} &= x_k + dt_k[u_k]`` (forward), ``x_k &= x_{k+1} - dt_k[u_k]`` (backward), slices
     ``&= (x_k + [0,dt_k][u_k]) & (x_{k+1} - [0,dt_k][u_k])``, gates ``&=`` both adjacent slices; outward
-    rounded, vectorised over time (max-plus closed form, proof in :mod:`.ctc`).
+    rounded, vectorised over time (max-plus closed form, proof in :mod:`digslam.observer.tube.ctc`).
 
     Args:
         x: the tube to contract (not modified).
