@@ -7,6 +7,7 @@ Used by ``tests/test_architecture.py`` to check the rules written in the folders
 from __future__ import annotations
 
 import ast
+import importlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -27,6 +28,21 @@ class Module:
     @property
     def folder(self) -> str:
         return self.name if self.is_package else self.name.rsplit(".", 1)[0]
+
+
+def import_dotted(path: str) -> object | None:
+    """The object a dotted ``digslam....`` path names (its longest importable prefix, then attributes), or
+    None when no prefix imports; an attribute that is missing raises ``AttributeError``."""
+    parts = path.split(".")
+    for cut in range(len(parts), 1, -1):
+        try:
+            obj = importlib.import_module(".".join(parts[:cut]))
+        except ModuleNotFoundError:
+            continue
+        for attr in parts[cut:]:
+            obj = getattr(obj, attr)
+        return obj
+    return None
 
 
 def _is_kernel(fn: ast.FunctionDef) -> bool:

@@ -13,7 +13,7 @@ import warnings
 from pathlib import Path
 
 import pytest
-from architecture import REPO, cycles, graph, scan, third_party
+from architecture import REPO, cycles, graph, import_dotted, scan, third_party
 
 MODS = scan()
 
@@ -148,16 +148,8 @@ def test_every_listed_name_imports(pkg: str) -> None:
 
 @pytest.mark.parametrize("path", DOCUMENTED)
 def test_every_path_in_the_readme_imports(path: str) -> None:
-    parts = path.split(".")
-    for cut in range(len(parts), 1, -1):  # the longest importable prefix, then attributes
-        try:
-            obj = importlib.import_module(".".join(parts[:cut]))
-        except ModuleNotFoundError:
-            continue
-        for attr in parts[cut:]:
-            obj = getattr(obj, attr)
-        return
-    pytest.fail(f"{path} does not import")
+    if import_dotted(path) is None:
+        pytest.fail(f"{path} does not import")
 
 
 @pytest.mark.parametrize("old", OLD_PATHS)

@@ -59,6 +59,21 @@ def shortest_paths(
     return dist.reshape(h, w), pred
 
 
+def _with_starts(free: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A copy of ``free`` with the ``(S, 2)`` pixels ``starts`` made free, and the starts as int64, checked.
+
+    Raises:
+        ValueError: a start outside the grid.
+    """
+    free = np.asarray(free, dtype=bool).copy()
+    starts = np.asarray(starts, dtype=np.int64).reshape(-1, 2)
+    h, w = free.shape
+    if starts.size and not ((starts >= 0).all() and (starts[:, 0] < h).all() and (starts[:, 1] < w).all()):
+        raise ValueError(f"starts: a pixel lies outside the {h} x {w} grid")
+    free[starts[:, 0], starts[:, 1]] = True
+    return free, starts
+
+
 def path_lengths(free: np.ndarray, starts: np.ndarray, weight: np.ndarray | None = None) -> np.ndarray:
     """``(S, h, w)`` path lengths from each of the ``(S, 2)`` pixels ``starts`` over the same graph as
     :func:`shortest_paths` (one Dijkstra call for all of them; the starts are treated as free).
@@ -67,12 +82,8 @@ def path_lengths(free: np.ndarray, starts: np.ndarray, weight: np.ndarray | None
     >>> path_lengths(free, np.array([[0, 0], [0, 3]]))[:, 0, 3].round(3).tolist()   # around the wall, and 0
     [6.414, 0.0]
     """
-    free = np.asarray(free, dtype=bool).copy()
-    starts = np.asarray(starts, dtype=np.int64).reshape(-1, 2)
+    free, starts = _with_starts(free, starts)
     h, w = free.shape
-    if starts.size and not ((starts >= 0).all() and (starts[:, 0] < h).all() and (starts[:, 1] < w).all()):
-        raise ValueError(f"starts: a pixel lies outside the {h} x {w} grid")
-    free[starts[:, 0], starts[:, 1]] = True
     if not len(starts):
         return np.zeros((0, h, w))
     flat = starts[:, 0] * w + starts[:, 1]
@@ -88,12 +99,8 @@ def pair_lengths(free: np.ndarray, starts: np.ndarray, weight: np.ndarray | None
     >>> pair_lengths(free, np.array([[0, 0], [0, 3]])).round(3).tolist()
     [[0.0, 6.414], [6.414, 0.0]]
     """
-    free = np.asarray(free, dtype=bool).copy()
-    starts = np.asarray(starts, dtype=np.int64).reshape(-1, 2)
+    free, starts = _with_starts(free, starts)
     h, w = free.shape
-    if starts.size and not ((starts >= 0).all() and (starts[:, 0] < h).all() and (starts[:, 1] < w).all()):
-        raise ValueError(f"starts: a pixel lies outside the {h} x {w} grid")
-    free[starts[:, 0], starts[:, 1]] = True
     flat = starts[:, 0] * w + starts[:, 1]
     return pj.grid_lengths(*_grid_args(free, weight), flat, flat)[:, flat]
 
