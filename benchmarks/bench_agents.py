@@ -22,8 +22,12 @@ baseline with its paired bootstrap 95 % interval), writes ``leaderboard.md``, ``
 * ``eval_steps_per_s=<observed env steps per second with the frontier agent, one process>`` and
   ``eval_over_observed=<that over the observed env's own steps per second on the same path, its step calls
   timed apart from the agent's in the same run>`` (:func:`digslam.agents.evaluation.suite.eval_rates`);
-* with a learned model: ``speedup_<generator>=`` and ``speedup=<geometric mean over the test maps of all
-  generators of T_level(best heuristic) / T_level(learned)> [paired bootstrap 95 % interval]``.
+* with a learned agent: ``speedup_<generator>=`` and ``speedup=<geometric mean over the test maps of all
+  generators of T_level(best heuristic) / T_level(best learned agent)> [paired bootstrap 95 % interval]``;
+* with ``predictive_frontier``: ``oracle_speedup_<generator>=`` and ``oracle_speedup=``, the same for the
+  ``oracle`` row (the predictive planner on the true map, :mod:`digslam.agents.prediction.oracle`: a
+  diagnosis, not an agent, never the best agent), and ``predictor_iou_dark=`` (the shipped map predictor's
+  IoU on the open pixels of its validation snapshots, from its sidecar).
 
 ``--model`` takes any model of ``digslam train``, a goal-selection MaskablePPO model included.
 
@@ -65,8 +69,11 @@ ENV_ID = "digslam/DigCoverage-v0"
 MODEL = Path(__file__).resolve().parents[1] / "agents" / "data" / "goals_attention.zip"
 #: The low-level PPO policy (continuous actions on the map), a comparison row (``ppo_lowlevel``).
 LOWLEVEL = Path(__file__).resolve().parents[1] / "agents" / "data" / "ppo_digcoverage.zip"
-#: The learned rows: ``ppo`` (``--model``) and ``ppo_lowlevel`` (``--lowlevel``).
-LEARNED = ("ppo", "ppo_lowlevel")
+#: The learned rows: ``ppo`` (``--model``), ``ppo_lowlevel`` (``--lowlevel``) and ``predictive_frontier`` (the
+#: frontier agent on the shipped map predictor's map, ``agents/data/map_predictor.pt``).
+LEARNED = ("ppo", "ppo_lowlevel", "predictive_frontier")
+#: The diagnosis row that runs beside ``predictive_frontier``: the same planner on the true map.
+ORACLE = "oracle"
 
 
 def model_kwargs(model: Path) -> dict[str, Any]:
@@ -103,7 +110,7 @@ def chosen_baselines(agents: list[str] | None) -> list[str]:
     """
     if agents is None:
         return list(BASELINES)
-    unknown = [a for a in agents if a not in BASELINES and a not in LEARNED]
+    unknown = [a for a in agents if a not in BASELINES and a not in LEARNED and a != ORACLE]
     if unknown:
         raise ValueError(f"--agents: unknown {unknown}; known: {sorted(BASELINES)}, {', '.join(LEARNED)}")
     return [a for a in BASELINES if a in agents or a == "frontier"]
@@ -173,7 +180,7 @@ def main() -> None:
     extra = {name: dict(common) for name in names}
     if loaded is not None:  # the rows of the runs read: their baselines and learned agents
         baselines = [a for a in BASELINES if a in loaded.agents]
-        args.agents = [a for a in loaded.agents if a in BASELINES or a in LEARNED]
+        args.agents = [a for a in loaded.agents if a in BASELINES or a in LEARNED or a == ORACLE]
     ppo = load_ppo(args.model) if args.agents is None or "ppo" in args.agents else None
     if ppo is not None:
         policies["ppo"], extra["ppo"] = ppo, {**model_kwargs(args.model), **common}
@@ -184,6 +191,9 @@ def main() -> None:
         low = load_ppo(args.lowlevel)
     if low is not None:
         policies["ppo_lowlevel"], extra["ppo_lowlevel"] = low, {**model_kwargs(args.lowlevel), **common}
+    wanted = args.agents is None or "predictive_frontier" in args.agents
+    if wanted and loaded is None:
+        add_predictive(policies, extra, common, args.ray)
     if common:
         print(f"environment keywords of every agent: {common}")
     t0 = time.perf_counter()
@@ -209,7 +219,7 @@ def main() -> None:
     (args.out / "leaderboard.md").write_text(table + "\n")
     print(f"wrote {args.out / 'leaderboard.md'}, {res.figure(args.out / 'leaderboard.png')} and "
           f"{res.to_json(args.out / 'suite.json')}")  # fmt: skip
-    best = res.best(baselines + [a for a in LEARNED if a in res.agents])
+    best = res.best(baselines + [a for a in LEARNED if a in res.agents])  # never the oracle: not an agent
     record = leaderboard_record(best, float(res.times()[best].mean()), maps, steps, list(res.results),
                                 {g: TARGET_LEVELS.get(g, 0.9) for g in res.results})  # fmt: skip
     text = json.dumps(record, indent=2) + "\n"
@@ -232,16 +242,68 @@ def main() -> None:
         print(f"learned_choices: {st['decisions']:.0f} decisions, {100 * st['not_first']:.1f} % differ from the "
               f"frontier agent's pick; frontier {100 * st['frontier']:.1f} %, loop closure "
               f"{100 * st['closure']:.1f} %, turn in place {100 * st['turn']:.1f} %")  # fmt: skip
-    if "ppo" in res.agents:  # the learned agent: geometric mean over the maps of T_level(best) / T_level(ppo)
-        m = res.metrics()
-        for g in res.results:
-            lv = res.level_name(g)
-            r, lo, hi = paired_bootstrap_geomean(m[g][best][lv], m[g]["ppo"][lv])
-            print(f"speedup_{g}={r:.4f} [{lo:.4f}, {hi:.4f}]")
-        t = res.times()
-        r, lo, hi = paired_bootstrap_geomean(t[best], t["ppo"])
-        print(f"speedup={r:.4f} [{lo:.4f}, {hi:.4f}] (T_level of {best} / T_level of ppo, geometric mean over "
-              "the maps)")  # fmt: skip
+    learned = [a for a in LEARNED if a in res.agents]
+    if learned:  # the best learned agent: geometric mean over the maps of T_level(best) / T_level(learned)
+        top = res.best(learned)
+        print_speedup(res, best, top, "speedup")
+    if ORACLE in res.agents:
+        print_speedup(res, best, ORACLE, "oracle_speedup")
+    iou = predictor_iou()
+    if iou is not None:
+        print(
+            f"predictor_iou_dark={iou:.4f} (the shipped map predictor on validation snapshots, open pixels)"
+        )
+
+
+def print_speedup(res: SuiteResult, best: str, agent: str, key: str) -> None:
+    """``<key>_<generator>=`` and ``<key>=``: geometric mean over the maps of ``T_level(best) / T_level(agent)``
+    with its paired bootstrap 95 % interval."""
+    m = res.metrics()
+    for g in res.results:
+        lv = res.level_name(g)
+        r, lo, hi = paired_bootstrap_geomean(m[g][best][lv], m[g][agent][lv])
+        print(f"{key}_{g}={r:.4f} [{lo:.4f}, {hi:.4f}]")
+    t = res.times()
+    r, lo, hi = paired_bootstrap_geomean(t[best], t[agent])
+    print(f"{key}={r:.4f} [{lo:.4f}, {hi:.4f}] (T_level of {best} / T_level of {agent}, geometric mean over "
+          "the maps)")  # fmt: skip
+
+
+def add_predictive(
+    policies: dict[str, Any], extra: dict[str, Any], common: dict[str, Any], ray: bool
+) -> None:
+    """The ``predictive_frontier`` row on the shipped map predictor and the ``oracle`` diagnosis beside it
+    (a factory: it reads the true map of the env it plays), or a printed note why not."""
+    if ray:
+        print("note: predictive_frontier and the oracle run without --ray only; skipped")
+        return
+    try:
+        from digslam.agents.prediction import make_predictive
+        from digslam.agents.prediction.oracle import oracle_factory
+
+        env = gym.make(ENV_ID, **common)
+        try:
+            policies["predictive_frontier"] = make_predictive(env, seed=0)
+        finally:
+            env.close()
+    except (ImportError, ValueError) as exc:
+        print(f"note: predictive_frontier skipped ({str(exc).splitlines()[0]})")
+        return
+    policies[ORACLE] = oracle_factory()
+    extra["predictive_frontier"], extra[ORACLE] = dict(common), dict(common)
+
+
+def predictor_iou() -> float | None:
+    """The shipped map predictor's IoU on the open pixels of its validation snapshots (its sidecar)."""
+    from digslam.agents.prediction.model import SHIPPED
+
+    side = SHIPPED.with_suffix(".json")
+    if not side.is_file():
+        return None
+    try:
+        return float(json.loads(side.read_text())["validation"]["all"]["predictor"]["iou"])
+    except (KeyError, TypeError, ValueError):
+        return None
 
 
 if __name__ == "__main__":

@@ -38,6 +38,8 @@ ALLOWED: dict[str, set[str]] = {
     "agents.evaluation": {"observer.core", "observer.thick", "envs", "envs.sim", "envs.explore",
                           "envs.dig_coverage", "agents.baselines", "agents.learning"},
     "agents.goals": {"envs", "agents.baselines"},
+    "agents.prediction": {"observer.core", "envs", "envs.dig_coverage", "agents.baselines", "agents.evaluation",
+                          "agents.goals", "agents.learning"},
 }  # fmt: skip
 FOLDERS = sorted(m.name for m in MODS.values() if m.is_package and m.name.count(".") == 1)
 

@@ -364,11 +364,15 @@ class FrontierAgent(NavigatingAgent):
                 np.angle(np.exp(1j * (np.arctan2(view.pos[0] - rr, cc - view.pos[1]) - view.heading)))
             )
             cost += self.turn_weight * err / self._turn * (self.max_speed * self.dt) / px
-        if self.gain_weight > 0:  # the expected gain: the dark share of the square of the sensor range
-            k = 2 * int(round(self.sensor_range / px)) + 1
-            gain = ndimage.uniform_filter(view.dark.astype(np.float64), size=k, mode="constant")
-            cost -= self.gain_weight * gain / px
+        if self.gain_weight > 0:
+            cost -= self.gain_weight * self.expected_gain(view, mem, np.isfinite(cost)) / px
         return cost
+
+    def expected_gain(self, view: View, mem: Memory, candidates: np.ndarray) -> np.ndarray:
+        """``(m, m)`` expected gain of each candidate pixel, in ``[0, 1]`` (weighted by ``gain_weight``):
+        here the dark share of the square of side twice the sensor range around the pixel."""
+        k = 2 * int(round(self.sensor_range / self.px(view.clear.shape[0]))) + 1
+        return ndimage.uniform_filter(view.dark.astype(np.float64), size=k, mode="constant")
 
     def _costs(self, view: View, mem: Memory, reach: np.ndarray, dist: np.ndarray) -> np.ndarray:
         return self.frontier_costs(view, mem, reach, dist)

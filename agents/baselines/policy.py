@@ -45,6 +45,7 @@ class View:
     heading: float
     tube: float  # m
     consistent: bool
+    image: np.ndarray | None = None  # the observation's uint8 map itself (what a map predictor reads)
 
     @property
     def cell(self) -> tuple[int, int]:
@@ -60,7 +61,8 @@ def parse(obs_map: np.ndarray, state: np.ndarray) -> View:
     ux, uy = 0.5 * (s[0] + s[2]), 0.5 * (s[1] + s[3])
     pos = np.array([(1.0 - uy) * 0.5 * m, (ux + 1.0) * 0.5 * m])
     tube = math.atanh(min(max(float(s[S_TUBE]), 0.0), 1.0 - 1e-7))
-    return View(img[0], img[1], img[2], pos, math.atan2(s[S_SIN], s[S_COS]), tube, s[S_CONSISTENT] > 0.5)
+    heading = math.atan2(s[S_SIN], s[S_COS])
+    return View(img[0], img[1], img[2], pos, heading, tube, s[S_CONSISTENT] > 0.5, np.asarray(obs_map))
 
 
 @dataclass

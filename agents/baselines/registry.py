@@ -45,7 +45,7 @@ BASELINES: dict[str, type[BaselinePolicy]] = {
 }
 
 
-def _observer_layer(env: Any) -> Any:
+def observer_layer(env: Any) -> Any:
     """The ``GuaranteedObserver`` layer of a (wrapped) env, or None."""
     e = env
     for _ in range(32):
@@ -65,19 +65,27 @@ def make_baseline(name: str, env: Any, seed: int | None = None) -> BaselinePolic
     """
     if name not in BASELINES:
         raise ValueError(f"name: unknown baseline {name!r}; known: {sorted(BASELINES)}")
+    return BASELINES[name](env.action_space, env.observation_space, seed=seed, **sizing(env))
+
+
+def sizing(env: Any) -> dict[str, Any]:
+    """The :class:`BaselinePolicy` keywords that size an agent for ``env``: grid span, speeds, step and
+    sensor range (none for an env without a ``GuaranteedObserver`` layer)."""
     kw: dict[str, Any] = {}
-    layer = _observer_layer(env)
+    layer = observer_layer(env)
     if layer is not None:
         g = layer.grid
         raw = layer.env.unwrapped
         kw.update(span=float(g.hi[0] - g.lo[0]), max_speed=raw.config.max_speed,
                   max_yaw_rate=raw.config.max_yaw_rate, dt=raw.config.dt,
                   sensor_range=float(raw.suite.r_max.max()))  # fmt: skip
-    return BASELINES[name](env.action_space, env.observation_space, seed=seed, **kw)
+    return kw
 
 
 __all__ = [
     "BASELINES",
+    "observer_layer",
+    "sizing",
     "BaselinePolicy",
     "DistanceAdvantageAgent",
     "FrontierAgent",

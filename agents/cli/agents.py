@@ -25,7 +25,7 @@ def agent_names() -> list[str]:
     the baselines."""
     from digslam.agents.baselines.registry import BASELINES
 
-    return ["best", "ppo", *BASELINES]
+    return ["best", "ppo", *BASELINES, "predictive_frontier"]
 
 
 def model_env_kwargs(model: Path | None = None) -> dict[str, Any]:
@@ -47,7 +47,8 @@ def load_ppo(path: Path, env: Any) -> Any:
 
 def load_agent(name: str, env: Any, model: Path | None = None) -> Any:
     """A policy with SB3's ``predict``: ``"ppo"`` (a saved PPO model, default the shipped one; a goal-level
-    model comes as a :class:`~digslam.agents.goals.GoalAgent`) or a baseline name of
+    model comes as a :class:`~digslam.agents.goals.GoalAgent`), ``"predictive_frontier"`` (on the map
+    predictor ``model``, default the shipped one) or a baseline name of
     :data:`digslam.agents.baselines.registry.BASELINES`.
 
     Raises:
@@ -57,6 +58,17 @@ def load_agent(name: str, env: Any, model: Path | None = None) -> Any:
         return load_ppo(Path(model) if model is not None else models.PRETRAINED, env)
     if name == "best":
         name = models.best_agent()[0]
+    if name == "predictive_frontier":
+        from digslam.agents.prediction import make_predictive
+
+        try:
+            if model is None:
+                return make_predictive(env)
+            from digslam.agents.prediction.model import load
+
+            return make_predictive(env, predictor=load(model))  # a map predictor of `digslam train`
+        except (ImportError, ValueError) as exc:
+            raise UserError(f"--agent predictive_frontier: {exc}") from None
     if name not in agent_names() or name == "best":
         raise UserError(f"--agent {name!r}: unknown agent; known: {', '.join(agent_names())}")
     from digslam.agents.baselines.registry import make_baseline
@@ -77,8 +89,8 @@ def resolve_agent(name: str, env_id: str, model: Path | None) -> tuple[str, Any,
         best, why = models.best_agent()
         print(f"--agent best: {best}, {why}")
         name = best if best in agent_names() and best != "best" else "frontier"
-    if model is not None and name != "ppo":
-        raise UserError(f"--model: only with --agent ppo (got --agent {name})")
+    if model is not None and name not in ("ppo", "predictive_frontier"):
+        raise UserError(f"--model: only with --agent ppo or predictive_frontier (got --agent {name})")
     pretrained = models.PRETRAINED  # read at call time (tests point it elsewhere)
     path = Path(model) if model is not None else pretrained
     kwargs = model_env_kwargs(path) if name == "ppo" else {}

@@ -67,7 +67,8 @@ class _NoSigint:
 
 
 def cmd_train(args: argparse.Namespace) -> int:
-    """``digslam train``: PPO from a config file plus ``key=value`` overrides."""
+    """``digslam train``: PPO (or, for a ``kind = "map_predictor"`` file, the map predictor) from a config
+    file plus ``key=value`` overrides."""
     from digslam.agents.learning.train import TrainConfig, TrainingInterrupted, train
 
     config, overrides = args.config, list(args.overrides)
@@ -75,6 +76,18 @@ def cmd_train(args: argparse.Namespace) -> int:
         config, overrides = None, [config, *overrides]
     if config is not None and Path(config).is_dir():
         raise UserError(f"{config}: is a folder; give a .toml or .json training configuration")
+    from digslam.agents.prediction.fit import PredictorConfig, fit, is_predictor_config
+
+    if is_predictor_config(config):  # kind = "map_predictor": the map predictor, not a PPO run
+        pcfg = PredictorConfig.from_file(config, overrides)
+        out_path(pcfg.out_dir, "out_dir")
+        try:
+            import torch  # noqa: F401
+        except ImportError:
+            raise UserError('the map predictor needs torch; pip install "digslam[train]"') from None
+        print(f"training: {pcfg}")
+        print(f"saved {fit(pcfg, command=' '.join(['digslam train', config, *overrides]))}")
+        return 0
     cfg = TrainConfig.from_file(config, overrides)
     check_env_id(cfg.env_id, "train", opt="env_id", goals=True)
     make_env(cfg.env_id, dict(cfg.env_kwargs), "env_kwargs").close()  # here, before any worker starts

@@ -202,6 +202,8 @@ def evaluate(
 ) -> EvalResult:
     """Every policy on the same ``n_maps`` held-out maps (map ``i``: ``reset(seed=seed + i)``), ``steps``
     steps each (``max_episode_steps=steps`` and ``fixed_world=False`` unless ``env_kwargs`` says otherwise).
+    A policy may also be a factory ``env -> policy``, called once on the env it plays (the true-map
+    diagnosis of :mod:`digslam.agents.prediction.oracle` reads that env's ground truth).
 
     Raises:
         ValueError: no policies, a policy without ``predict``, or a non-positive ``n_maps``/``steps``.
@@ -209,8 +211,8 @@ def evaluate(
     if not policies:
         raise ValueError("policies: need at least one agent")
     for name, p in policies.items():
-        if not callable(getattr(p, "predict", None)):
-            raise ValueError(f"policies: {name!r} has no predict(obs) method")
+        if not (callable(getattr(p, "predict", None)) or callable(p)):
+            raise ValueError(f"policies: {name!r} has no predict(obs) method and is no factory env -> policy")
     if not (isinstance(n_maps, int) and n_maps >= 1):
         raise ValueError(f"n_maps: must be an integer >= 1, got {n_maps!r}")
     if not (isinstance(steps, int) and steps >= 1):
@@ -223,6 +225,8 @@ def evaluate(
     out: dict[str, dict[str, np.ndarray]] = {k: {} for k in "ctbwnp"}
     for name, policy in policies.items():
         env = make_env(env_id, steps, env_kwargs)
+        if not callable(getattr(policy, "predict", None)):
+            policy = policy(env)  # a factory: an agent built on the env it plays (the oracle diagnosis)
         try:
             rows = []
             for i in range(n_maps):

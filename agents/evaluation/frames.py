@@ -35,6 +35,7 @@ PALETTE: dict[str, tuple[int, int, int]] = {
     "clear": RGB[int(CLEAR)],  # sky blue: the env's render and the GIF share the sets' colours
     "penumbra": RGB[int(PENUMBRA)],  # orange
     "dark": RGB[int(DARK)],  # near black
+    "predicted": (60, 64, 92),  # faint slate on the dark: the map predictor's guess, never a claim
     "obstacle": (150, 150, 150),  # grey
     "echo": (170, 51, 119),  # purple (Tol's): far from the penumbra's orange and the clear blue
     "robot": (0, 158, 115),  # bluish green
@@ -60,7 +61,9 @@ LEGEND: tuple[tuple[str, str, str], ...] = (
     ("box", "pose box", f"the robot is proved inside; >= {ov.MIN_BOX_PX} px here"),
     ("robot", "true robot", "ground truth, hidden from the robot"),
 )
-LEGEND_TOP, LEGEND_ROW = 174, 40
+#: The extra legend row of an agent that predicts the map (``FrameDrawer(..., prediction=True)``).
+PREDICTED = ("predicted", "predicted free (a guess)", "the map predictor's p >= 0.5 on dark ground")
+LEGEND_TOP, LEGEND_ROW = 174, 36
 
 
 def _font(size: int) -> Any:
@@ -84,7 +87,9 @@ class FrameDrawer:
     and draws the frame.
     """
 
-    def __init__(self, layer: Any, title: str, target: float | None, steps: int) -> None:
+    def __init__(
+        self, layer: Any, title: str, target: float | None, steps: int, prediction: bool = False
+    ) -> None:
         from PIL import Image, ImageDraw
 
         from digslam.envs.sim.raster import FREE, rasterize
@@ -114,7 +119,7 @@ class FrameDrawer:
         if target is not None:
             d.text((162, 126), f"(target {target:.2f}: purple tick)", fill=INDEX["ink"], font=self.small)
         d.text((12, LEGEND_TOP - 22), "legend (what the observer proves)", fill=INDEX["ink"], font=self.font)
-        for k, (key, name, words) in enumerate(LEGEND):
+        for k, (key, name, words) in enumerate(LEGEND + ((PREDICTED,) if prediction else ())):
             y = LEGEND_TOP + k * LEGEND_ROW
             self._swatch(d, key, 12, y)
             d.text((46, y - 1), name, fill=INDEX["ink"], font=self.font)
@@ -179,13 +184,17 @@ class FrameDrawer:
         idx[self._obstacles & ~clear] = INDEX["obstacle"]
         return idx
 
-    def frame(self, info: dict[str, Any], step: int) -> Any:
+    def frame(self, info: dict[str, Any], step: int, prediction: np.ndarray | None = None) -> Any:
         """The ``P``-mode frame of ``info`` (the wrapper's info after ``step`` steps; the observer's sets are
-        the info's with ``info_sets=True``, else the layer's now, :meth:`GuaranteedObserver.sets`)."""
+        the info's with ``info_sets=True``, else the layer's now, :meth:`GuaranteedObserver.sets`);
+        ``prediction``, an agent's ``(m, m)`` predicted free probabilities of the map's pixels, is drawn
+        faintly on the dark cells where it is at least 0.5."""
         from PIL import Image, ImageDraw
 
         self.observe(info, step)
         idx = self._cells(info)
+        if prediction is not None:
+            self._predicted(idx, np.asarray(prediction, np.float64))
         s = self.scale
         big = np.repeat(np.repeat(idx, s, axis=0), s, axis=1)
         canvas = np.full((MAP_SIZE, MAP_SIZE + PANEL_WIDTH), INDEX["background"], np.uint8)
@@ -227,6 +236,15 @@ class FrameDrawer:
                 img, d, (ix, iy + INSET_SIZE + 30), k, INSET_SIZE / 2.5, (ink, paper), self.small, self.write
             )
         return img
+
+    def _predicted(self, idx: np.ndarray, p: np.ndarray) -> None:
+        """Mark the dark cells of ``idx`` whose map pixel (the map's block of cells) is predicted free."""
+        from digslam.envs.dig_coverage.maps_jit import block_starts
+
+        rows = np.searchsorted(block_starts(self.ny, p.shape[0]), np.arange(self.ny), side="right") - 1
+        cols = np.searchsorted(block_starts(self.nx, p.shape[1]), np.arange(self.nx), side="right") - 1
+        free = p[np.ix_(rows, cols)] >= 0.5
+        idx[free & (idx == INDEX["dark"])] = INDEX["predicted"]
 
     def _inset(self, idx: np.ndarray, box: np.ndarray | None, pose: tuple[float, float, float]) -> Any:
         """The inset: the map around the pose box's centre, magnified so the box has its true size, with the

@@ -65,7 +65,10 @@ def demo_episode(
     try:
         obs, info = env.reset(seed=seed)
         title = f"{env_id.split('/')[-1]}: {name}"
-        drawer = FrameDrawer(_observer_layer(env), title, info.get("target"), steps)
+        shown = getattr(policy, "shown_prediction", None)  # an agent that predicts the map shows its guess
+        shown = shown if callable(shown) else (lambda: None)
+        drawer = FrameDrawer(_observer_layer(env), title, info.get("target"), steps,
+                             prediction=callable(getattr(policy, "shown_prediction", None)))  # fmt: skip
         frames = [drawer.frame(info, 0)]
         cert[0], true[0] = info["certified_coverage"], info["true_coverage"]
         state, start, n = None, np.ones(1, dtype=bool), 0
@@ -77,7 +80,7 @@ def demo_episode(
             cert[n], true[n] = info["certified_coverage"], info["true_coverage"]
             done = terminated or truncated
             if n % stride == 0 or done or n == steps:
-                frames.append(drawer.frame(info, n))
+                frames.append(drawer.frame(info, n, shown()))
             else:
                 drawer.observe(info, n)  # the estimated path has every step
             if done:

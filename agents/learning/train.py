@@ -192,39 +192,54 @@ class TrainConfig(Config):
     @classmethod
     def from_file(cls, path: str | Path | None = None, overrides: Iterable[str] = ()) -> TrainConfig:
         """Read a ``.toml`` or ``.json`` file (None: :data:`DEFAULT_CONFIG`), then apply ``overrides``."""
-        p = Path(path) if path is not None else DEFAULT_CONFIG
-        if not p.is_file():
-            raise ValueError(f"path: no configuration file {str(p)!r}")
-        if p.suffix not in (".json", ".toml"):
-            raise ValueError(f"path: configuration must be .toml or .json, got {str(p)!r}")
-        try:
-            text = p.read_text()
-            data = json.loads(text) if p.suffix == ".json" else tomllib.loads(text)
-        except (OSError, UnicodeDecodeError, ValueError) as exc:  # TOMLDecodeError, JSONDecodeError
-            raise ValueError(f"path: cannot read {str(p)!r} as {p.suffix[1:].upper()} ({exc})") from None
-        if not isinstance(data, dict):
-            raise ValueError(f"path: {str(p)!r} must hold a table of settings, got {type(data).__name__}")
-        return cls.from_dict(data).override(overrides)
+        return cls.from_dict(read_config_file(path if path is not None else DEFAULT_CONFIG)).override(
+            overrides
+        )
 
     def override(self, overrides: Iterable[str]) -> TrainConfig:
         """Apply ``key=value`` strings (values parsed as TOML literals, else taken as strings)."""
-        data = self.to_dict()
-        for item in overrides:
-            key, sep, raw = item.partition("=")
-            key = key.strip()
-            if not sep or not key:
-                raise ValueError(f"overrides: expected key=value, got {item!r}")
-            value = parse_value(raw.strip())
-            head, _, sub = key.partition(".")
-            if head not in data:
-                raise ValueError(f"{head}: unknown key; known: {sorted(data)}")
-            if sub:
-                if head != "env_kwargs":
-                    raise ValueError(f"{key}: only env_kwargs takes dotted keys")
-                data[head] = {**data[head], sub: value}
-            else:
-                data[head] = value
-        return TrainConfig.from_dict(data)
+        return TrainConfig.from_dict(apply_overrides(self.to_dict(), overrides, dotted=("env_kwargs",)))
+
+
+def read_config_file(path: str | Path) -> dict[str, Any]:
+    """The table of settings in a ``.toml`` or ``.json`` file; ``ValueError`` saying what is wrong."""
+    p = Path(path)
+    if not p.is_file():
+        raise ValueError(f"path: no configuration file {str(p)!r}")
+    if p.suffix not in (".json", ".toml"):
+        raise ValueError(f"path: configuration must be .toml or .json, got {str(p)!r}")
+    try:
+        text = p.read_text()
+        data = json.loads(text) if p.suffix == ".json" else tomllib.loads(text)
+    except (OSError, UnicodeDecodeError, ValueError) as exc:  # TOMLDecodeError, JSONDecodeError
+        raise ValueError(f"path: cannot read {str(p)!r} as {p.suffix[1:].upper()} ({exc})") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"path: {str(p)!r} must hold a table of settings, got {type(data).__name__}")
+    return data
+
+
+def apply_overrides(data: Mapping[str, Any], overrides: Iterable[str],
+                    dotted: Sequence[str] = ()) -> dict[str, Any]:  # fmt: skip
+    """``data`` with ``key=value`` strings applied (values parsed as TOML literals, else taken as strings);
+    ``head.sub=value`` sets one entry of a table field named in ``dotted``."""
+    data = dict(data)
+    for item in overrides:
+        key, sep, raw = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise ValueError(f"overrides: expected key=value, got {item!r}")
+        value = parse_value(raw.strip())
+        head, _, sub = key.partition(".")
+        if head not in data:
+            raise ValueError(f"{head}: unknown key; known: {sorted(data)}")
+        if sub:
+            if head not in dotted:
+                raise ValueError(f"{key}: only {' and '.join(dotted)} takes dotted keys" if dotted
+                                 else f"{key}: no key takes dotted keys")  # fmt: skip
+            data[head] = {**data[head], sub: value}
+        else:
+            data[head] = value
+    return data
 
 
 def parse_value(raw: str) -> Any:

@@ -30,7 +30,8 @@ SCRIPTS = sorted(p.stem for p in BENCHMARKS.glob("bench_*.py"))
 KEYS: dict[str, tuple[str, ...]] = {
     name: tuple(keys.split())
     for name, keys in {
-        "bench_agents": "best_heuristic heuristic_level_success eval_steps_per_s eval_over_observed",
+        "bench_agents": "best_heuristic heuristic_level_success eval_steps_per_s eval_over_observed speedup "
+        "oracle_speedup predictor_iou_dark",
         "bench_cold_start": "cold_first_contract_s warm_first_contract_s cold_over_warm_contract",
         "bench_levels": "levels_match",
         "bench_digslam": "seconds",
@@ -41,6 +42,7 @@ KEYS: dict[str, tuple[str, ...]] = {
         "bench_observer": "raw_steps_per_s observed_steps_per_s_q1 observer_overhead_q1 observed_q1_over_q0 "
         "observer_overhead_unicycle observed_steps_per_s observer_update_median_ms observer_overhead",
         "bench_paver": "ratio_vs_codac",
+        "bench_predictor": "predictor_iou_dark predictor_accuracy predictor_ece base_rate_iou dilate_iou",
         "bench_polar": "ratio_vs_codac",
         "bench_sweep": "speedup",
         "bench_teacher": "levels rollout_speedup_t90 fresh_noise_speedup_t90",

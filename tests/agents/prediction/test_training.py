@@ -1,0 +1,75 @@
+"""The map predictor end to end: ``digslam train`` on a tiny configuration, then ``demo`` and ``evaluate``
+with the predictive agent; the shipped predictor's smoke check of learning."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("torch")
+
+from digslam.agents.prediction.fit import PredictorConfig, is_predictor_config  # noqa: E402
+from digslam.agents.prediction.model import SHIPPED, load  # noqa: E402
+
+CONFIG = Path(__file__).resolve().parents[3] / "agents" / "configs" / "map_predictor.toml"
+
+
+def _digslam(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "digslam.agents.cli.main", *args], cwd=cwd,
+                          capture_output=True, text=True, timeout=600)  # fmt: skip
+
+
+def test_the_shipped_config_is_a_predictor_config():
+    assert is_predictor_config(CONFIG)
+    cfg = PredictorConfig.from_file(CONFIG, ["epochs=3"])
+    assert cfg.epochs == 3 and cfg.kind == "map_predictor"
+    with pytest.raises(ValueError, match="unknown"):
+        PredictorConfig.from_file(CONFIG, ["epoch=3"])
+
+
+def test_tiny_training_then_demo_and_evaluate(tmp_path):
+    tiny = ["generators=['room']", "train_levels=1", "val_levels=1", "episode_steps=60", "snapshot_every=30",
+            "epochs=1", "batch_size=2", "progress=false", f"out_dir='{tmp_path / 'run'}'",
+            f"data_dir='{tmp_path / 'data'}'"]  # fmt: skip
+    res = _digslam("train", str(CONFIG), *tiny, cwd=tmp_path)
+    assert res.returncode == 0, res.stderr[-2000:]
+    weights = tmp_path / "run" / "map_predictor.pt"
+    meta = json.loads(weights.with_suffix(".json").read_text())
+    assert meta["train_levels"] == 1 and meta["epochs_done"] == 1 and meta["seed"] == 0
+    assert {"predictor", "base_rate", "dilate"} <= set(meta["validation"]["all"])
+    assert "digslam train" in meta["command"] and meta["wall_s"] > 0
+    assert (tmp_path / "run" / "checkpoint.pt").is_file() and any((tmp_path / "run" / "tb").iterdir())
+    again = _digslam("train", str(CONFIG), *tiny, cwd=tmp_path)  # resumes: the one epoch is done already
+    assert again.returncode == 0 and "resuming after epoch 1" in again.stdout
+    demo = _digslam("demo", "--agent", "predictive_frontier", "--model", str(weights), "--steps", "40",
+                    "--out", str(tmp_path / "demo"), cwd=tmp_path)  # fmt: skip
+    assert demo.returncode == 0, demo.stderr[-2000:]
+    assert (tmp_path / "demo" / "episode.gif").is_file()
+    if SHIPPED.is_file():
+        ev = _digslam("evaluate", "--agents", "predictive_frontier", "frontier", "--maps", "1", "--steps", "40",
+                      "--out", str(tmp_path / "eval"), cwd=tmp_path)  # fmt: skip
+        assert ev.returncode == 0, ev.stderr[-2000:]
+        assert (
+            "predictive_frontier" in json.loads((tmp_path / "eval" / "evaluation.json").read_text())["curves"]
+        )
+
+
+@pytest.mark.skipif(not SHIPPED.is_file(), reason="no shipped map predictor")
+def test_the_shipped_predictor_continues_a_corridor():
+    """A straight corridor seen up to a point (clear floor, penumbra walls): its unseen continuation is
+    predicted free, more than the dark ground beside the corridor's walls."""
+    img = np.zeros((4, 64, 64), np.uint8)
+    img[2] = 255  # all dark
+    for ch, rows in ((1, slice(27, 37)), (0, slice(29, 35))):
+        img[:, rows, 4:30] = 0
+        img[ch, rows, 4:30] = 255
+    img[3, 31:33, 26:28] = 255  # the pose box near the seen end
+    p, _ = load(SHIPPED).free(img)
+    ahead = p[30:34, 32:40].mean()
+    beside = np.concatenate([p[12:20, 32:40].ravel(), p[44:52, 32:40].ravel()]).mean()
+    assert ahead > 0.5 and ahead > beside
