@@ -186,3 +186,17 @@ def test_every_moved_module_resolves_to_its_new_home(pkg: str, table: str) -> No
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DeprecationWarning)
             assert importlib.import_module(f"{pkg}.{old}") is importlib.import_module(target), old
+
+
+def test_every_folder_package_is_installed() -> None:
+    """pyproject lists its packages one by one: a folder missing there imports from the checkout and not
+    from an install (``pip install .``)."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
+        import tomli as tomllib  # type: ignore[no-redef]
+    listed = set(tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    for top in ("observer", "envs", "agents"):
+        for init in (REPO / top).rglob("__init__.py"):
+            rel = init.parent.relative_to(REPO).parts
+            assert ".".join(("digslam", *rel)) in listed, f"pyproject.toml: add digslam.{'.'.join(rel)}"
