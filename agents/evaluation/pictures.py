@@ -66,9 +66,9 @@ def demo_episode(
         obs, info = env.reset(seed=seed)
         title = f"{env_id.split('/')[-1]}: {name}"
         shown = getattr(policy, "shown_prediction", None)  # an agent that predicts the map shows its guess
-        shown = shown if callable(shown) else (lambda: None)
-        drawer = FrameDrawer(_observer_layer(env), title, info.get("target"), steps,
-                             prediction=callable(getattr(policy, "shown_prediction", None)))  # fmt: skip
+        predicts = callable(shown)
+        shown = shown if predicts else (lambda: None)
+        drawer = FrameDrawer(_observer_layer(env), title, info.get("target"), steps, prediction=predicts)
         frames = [drawer.frame(info, 0)]
         cert[0], true[0] = info["certified_coverage"], info["true_coverage"]
         state, start, n = None, np.ones(1, dtype=bool), 0
