@@ -2,9 +2,10 @@
 
 A robot loops for 20 minutes in the polygon room of Fig. 6.10 (frame [-10, 10]²), measuring its speed
 (±0.001 m/s), its heading (±0.001 rad), its yaw rate (±0.001 rad/s) and the distance to the nearest
-obstacle (±0.01 m) every 0.1 s; its initial position is known. Dig-SLAM (Algorithm 6.3) runs to its
-fixpoint and draws the tube, the dig zone ``M⁻`` against the true map and the explored zone (Fig. 6.12),
-and the tube width over time for dead reckoning and for each iteration (Fig. 6.13).
+obstacle (±0.01 m) every 0.1 s; its initial position is known. Dig-SLAM (Algorithm 6.3 as the thesis
+writes it, :func:`~digslam.observer.slam.digslam.thesis_dig_slam`) runs to its fixpoint and draws the tube,
+the dig zone ``M⁻`` against the true map and the explored zone (Fig. 6.12), and the tube width over time for
+dead reckoning and for each iteration (Fig. 6.13).
 
 Usage: ``python examples/ex6_4_digslam.py [--out DIR] [--duration S] [--cell M] [--seed N]``.
 """
@@ -19,7 +20,7 @@ from _common import parser, report, save_figure
 
 from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.missions import loop_mission
-from digslam.observer.slam.digslam import DigSlamResult, dig_slam
+from digslam.observer.slam.digslam import DigSlamResult, thesis_dig_slam
 from digslam.observer.slam.grid import Grid
 
 
@@ -29,7 +30,7 @@ def run(duration: float = 1200.0, cell: float = 0.05, seed: int = 0, out: str | 
     record, truth = loop_mission(world, duration=duration, seed=seed)
     grid = Grid.from_cell_size((-10.0, -10.0), (10.0, 10.0), cell)
     t0 = time.perf_counter()
-    res = dig_slam(record, grid, truth[0, :2], truth[0, :2])
+    res = thesis_dig_slam(record, grid, truth[0, :2], truth[0, :2])
     seconds = time.perf_counter() - t0
     inside = np.all((truth[:, :2] >= res.tube.gate_lo) & (truth[:, :2] <= res.tube.gate_hi), axis=1)
     stats = {

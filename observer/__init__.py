@@ -28,6 +28,7 @@ from digslam.observer.expr.ops import (
     tan,
 )
 from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam
+from digslam.observer.online.smoother import dig_slam
 from digslam.observer.paving.paver import Paving, PavingTree, pave
 from digslam.observer.paving.regular import classify_grid
 from digslam.observer.paving.subpaving import SepSubpaving, load, save, simplify
@@ -60,7 +61,7 @@ from digslam.observer.sets.sep_polygon import CtcPolygonBoundary, CtcSegments, S
 from digslam.observer.sets.separators import Sep, SepBox, SepInter, SepNot, SepQInter, SepUnion
 from digslam.observer.sets.transforms import CtcTransform, SepTransform, Transform, symmetric_union
 from digslam.observer.slam.digmap import DigMap
-from digslam.observer.slam.digslam import DigSlamConfig, DigSlamResult, dig_slam
+from digslam.observer.slam.digslam import DigSlamConfig, DigSlamResult
 from digslam.observer.slam.explicit_slam import (
     ExplicitSlamConfig,
     ExplicitSlamResult,

@@ -28,7 +28,7 @@ ALLOWED: dict[str, set[str]] = {
     "observer.tube": {"observer.core"},
     "observer.slam": {"observer.core", "observer.expr", "observer.sets", "observer.paving", "observer.polar",
                       "observer.thick", "observer.tube"},
-    "observer.online": {"observer.core", "observer.slam", "observer.thick"},
+    "observer.online": {"observer.core", "observer.slam", "observer.thick", "observer.tube"},
     "envs.sim": {"observer.core", "observer.slam", "envs"},
     "envs.explore": {"observer.core", "observer.slam", "envs.sim", "envs"},
     "envs.dig_coverage": {"observer.core", "observer.slam", "observer.thick", "observer.online", "envs.sim",

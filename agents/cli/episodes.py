@@ -121,7 +121,8 @@ def cmd_replay(args: argparse.Namespace) -> int:
     ok = same_episode(ep, again)
     print(f"{args.file}: {len(ep.actions)} steps, seed {ep.seed}; replay identical: {ok}")
     if args.digslam:
-        from digslam.observer.slam.digslam import DigSlamConfig, dig_slam
+        from digslam.observer.online.smoother import dig_slam
+        from digslam.observer.slam.digslam import DigSlamConfig
         from digslam.observer.slam.grid import Grid
 
         s = float(ep.config.world_size)

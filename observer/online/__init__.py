@@ -4,11 +4,14 @@ Lives here: :mod:`.observer` (``OnlineDigSlam``, ``OnlineConfig``), :mod:`.windo
 sliding window) and its kernels: :mod:`.dig_jit` (digging, the cone windows and the named tuples the
 kernels take: ``GridFrame``, ``CellSets``, ``PoseBox``, ``StepRecord``...), :mod:`.mark_jit`
 (marking the explored zone), :mod:`.pose_jit` (pose prediction and contraction), :mod:`.cones_jit` (the
-directional impact contractor: each echo's cone meets ``comp M⁻``) and :mod:`.step_jit` (one whole filter
-step, q-relaxed, Sec. 6.3).
+directional impact contractor: each echo's cone meets ``comp M⁻``), :mod:`.step_jit` (one whole filter
+step, q-relaxed, Sec. 6.3), :mod:`.smooth_jit` (the filter over a whole record and the smoothing sweeps over
+stored steps) and :mod:`.smoother` (``dig_slam``: offline Dig-SLAM, Alg. 6.3, the fixpoint of the filter's
+contractors over a record).
 
-May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.slam` (records, grid, dig map),
-:mod:`digslam.observer.thick` (the thick-set codes); numpy, numba.
+May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.slam` (records, grid, dig map, the tube
+pieces of Dig-SLAM), :mod:`digslam.observer.thick` (the thick-set codes), :mod:`digslam.observer.tube`
+(``C_d/dt`` of the offline tube); numpy, numba.
 """
 
 from .cones_jit import (
@@ -58,6 +61,15 @@ from .pose_jit import (
     predict,
     rotate,
 )
+from .smooth_jit import (
+    RecordArrays,
+    filter_record,
+    mark_record,
+    record_arrays,
+    smooth_pass,
+    step_at,
+)
+from .smoother import dig_slam
 from .step_jit import (
     filter_step,
     filter_step_flat,
@@ -80,6 +92,7 @@ __all__ = [
     "OnlineConfig",
     "OnlineDigSlam",
     "PoseBox",
+    "RecordArrays",
     "SectorBatch",
     "StepRecord",
     "WindowDigMap",
@@ -97,8 +110,10 @@ __all__ = [
     "dig_and_mark_q",
     "dig_batch",
     "dig_cells",
+    "dig_slam",
     "dig_reading",
     "edge_direction",
+    "filter_record",
     "filter_step",
     "filter_step_flat",
     "filter_step_q",
@@ -109,10 +124,14 @@ __all__ = [
     "mark_batch",
     "mark_cells",
     "mark_possibly_sensed",
+    "mark_record",
     "predict",
     "prod_hi",
     "prod_lo",
     "reach_axes",
+    "record_arrays",
     "rotate",
+    "smooth_pass",
+    "step_at",
     "union",
 ]

@@ -17,12 +17,15 @@ Each :meth:`OnlineDigSlam.update` takes the next single-step record and
    dug, possibly sensed = not proved outside every sensed sector, one compiled pass over the cells in
    sensor reach (:func:`.mark_jit.dig_and_mark`);
 4. optionally (``smoothing_window = W``) contracts the last ``W`` boxes backward,
-   ``x_j &= x_{j+1} - [d_j]``, and digs again the readings of the boxes that shrank.
+   ``x_j &= x_{j+1} - [d_j]``, and digs again the readings of the boxes that shrank; or
+   (``loop_smoothing``, :mod:`.history`) at a loop closure, a backward-forward pass over the stored history
+   that re-digs it and recomputes the possibly sensed zone, so that dark grows as the boxes shrink.
 
 Steps 1–3 run as one compiled call (:func:`.step_jit.filter_step_flat`, the same kernels chained), and
 :attr:`OnlineDigSlam.touched` grows by the smallest window holding the cells the step changed.
 
-State is a fixed set of arrays (plus a ring of ``W`` steps): memory does not grow with the episode.
+State is a fixed set of arrays (plus a ring of ``W`` steps, or the ``history`` steps of loop smoothing):
+memory does not grow with the episode.
 An empty box means the data contradict their bounds: the filter says so and stops, and withdraws its claims.
 
 **What is claimed, and when** (``q = 0``). If every interval of the records contains the truth, the true
@@ -74,6 +77,7 @@ import numpy as np
 from digslam.observer.core import rounding as rnd
 from digslam.observer.core.config import Config, check, check_int, config_dataclass
 from digslam.observer.online.dig_jit import NO_MEAN, CellSets, PoseBox, StepRecord
+from digslam.observer.online.history import StepHistory
 from digslam.observer.online.mark_jit import dig_and_mark_q
 from digslam.observer.online.step_jit import filter_step_flat
 from digslam.observer.online.window import WindowDigMap
@@ -100,6 +104,11 @@ class OnlineConfig(Config):
         q: the q-relaxed mode (thesis §2.6.2): at most ``q`` of the range readings of ONE step are outliers
             (their intervals may miss the truth; which ones is unknown). 0 (default): none, every claim as
             in Algorithm 6.3. See the module docstring.
+        loop_smoothing: smoothing at loop closures (:mod:`.history`): when the box has shrunk by more than
+            this share of its widest width since the last pass, a backward-forward pass over the stored
+            steps re-digs them and recomputes the possibly sensed zone. 0 (default): off.
+        history: the steps kept for ``loop_smoothing`` (memory bound: this many steps of the record plus one
+            grid mask; older steps are frozen).
     """
 
     smoothing_window: int = 0
@@ -107,9 +116,15 @@ class OnlineConfig(Config):
     cones: bool = True
     cone_every: int = 4
     q: int = 0
+    loop_smoothing: float = 0.0
+    history: int = 4000
 
     def __post_init__(self) -> None:
         check_int("smoothing_window", self.smoothing_window, 0)
+        v = self.loop_smoothing
+        ok = isinstance(v, int | float) and not isinstance(v, bool) and 0.0 <= v < 1.0
+        check(ok, "loop_smoothing", f"must be a share in [0, 1) (0: off), got {v!r}")
+        check_int("history", self.history, 2)
         for name in ("impacts", "cones"):
             v = getattr(self, name)
             check(isinstance(v, bool | np.bool_), name, f"must be a bool, got {v!r}")
@@ -119,6 +134,11 @@ class OnlineConfig(Config):
 
 #: The lateral velocity of a record built without one (a unicycle, the record's default); never written.
 _NO_SLIP = np.zeros(2)
+
+
+def band_of(psi: np.ndarray) -> tuple[float, float]:
+    """The heading interval ``(ψ⁻, ψ⁺)`` of a ``(2,)`` state array, as floats."""
+    return float(psi[0]), float(psi[1])
 
 
 def _step_record(rec: MissionRecord, dt: float) -> StepRecord:
@@ -181,6 +201,10 @@ class OnlineDigSlam:
         self._prev: MissionRecord | None = None
         self._ring.clear()
         self.touched = (0, self.grid.shape[0], 0, self.grid.shape[1])
+        cfg = self.config
+        #: The loop-closure history (:class:`.history.StepHistory`), or None when ``loop_smoothing`` is off.
+        self.history = (StepHistory(self.grid.shape, cfg.history, cfg.loop_smoothing, self._q)
+                        if cfg.loop_smoothing else None)  # fmt: skip
 
     def _check_record(self, rec: Any, name: str = "rec") -> MissionRecord:
         if not isinstance(rec, MissionRecord) or rec.t.ndim != 0:
@@ -250,6 +274,17 @@ class OnlineDigSlam:
         self.steps += 1
         if self.config.smoothing_window and not self._smooth():
             return self._fail(start)
+        h = self.history
+        if h is not None:
+            h.push(step, float(rec.t), self.pose_lo, self.pose_hi, band_of(psi), d, self.cells,
+                   self.dig.frame)  # fmt: skip
+            if h.due(self.pose_lo, self.pose_hi):
+                ok, changed = h.smooth(self.cells, self.dig.frame)
+                if not ok:
+                    return self._fail(start)
+                self.pose_lo, self.pose_hi = h.lo[h.n - 1].copy(), h.hi[h.n - 1].copy()
+                if changed:
+                    self.touched = (0, self.grid.shape[0], 0, self.grid.shape[1])
         self.last_update_seconds = time.perf_counter() - start
         return None
 
@@ -285,6 +320,9 @@ class OnlineDigSlam:
         self._dig(step, self.pose_lo, self.pose_hi, psi, mark=True)
         if self.config.smoothing_window:
             self._ring.append([step, self.pose_lo.copy(), self.pose_hi.copy(), psi, d])
+        if self.history is not None:
+            self.history.push(step, float(rec.t), self.pose_lo, self.pose_hi, psi, None, self.cells,
+                              self.dig.frame)  # fmt: skip
         self._prev = rec
         self.steps += 1
 

@@ -24,6 +24,7 @@ from .draw import (
 from .paver import (
     Paving,
     PavingTree,
+    connected_subsets,
     pave,
 )
 from .paver_jit import (
@@ -50,6 +51,7 @@ __all__ = [
     "PavingTree",
     "SepSubpaving",
     "classify_grid",
+    "connected_subsets",
     "draw_boxes",
     "draw_grid",
     "draw_paving",

@@ -77,6 +77,13 @@ class Paving:
         """Total volume left undetermined."""
         return float(volume(*self.boundary).sum()) if self.boundary[0].size else 0.0
 
+    def connected_subsets(self) -> list[Batch]:
+        """The connected components of ``X⁺ = inner ∪ boundary`` (:func:`connected_subsets`), each an
+        ``(lo, hi)`` batch of its boxes, the largest first."""
+        lo = np.concatenate([self.inner[0], self.boundary[0]])
+        hi = np.concatenate([self.inner[1], self.boundary[1]])
+        return [(lo[c], hi[c]) for c in connected_subsets(lo, hi)]
+
     def __repr__(self) -> str:
         return (
             f"Paving(inner={len(self.inner[0])}, outer={len(self.outer[0])}, "
@@ -202,8 +209,58 @@ def _parents(left: np.ndarray, n_nodes: int) -> np.ndarray:
     return parent
 
 
+def connected_subsets(lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
+    """Group closed boxes into the connected components of their union.
+
+    Two boxes are joined when they intersect (``lo_a <= hi_b`` and ``lo_b <= hi_a`` on every
+    coordinate, faces and corners included), and the union of a component is connected; boxes of
+    different components are disjoint, so the components of the union are exactly these groups.
+
+    Args:
+        lo, hi: an ``(N, n)`` batch of non-empty boxes.
+
+    Returns:
+        One ascending index array per component, the largest component first (ties: the one holding
+        the lowest index first).
+
+    >>> lo = np.array([[0.0, 0.0], [1.0, 1.0], [3.0, 0.0]])
+    >>> hi = np.array([[1.0, 1.0], [2.0, 2.0], [4.0, 1.0]])     # the first two touch at a corner
+    >>> [c.tolist() for c in connected_subsets(lo, hi)]
+    [[0, 1], [2]]
+    """
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    if lo.ndim != 2 or lo.shape != hi.shape:
+        raise ValueError(f"connected_subsets: expected two (N, n) arrays, got {lo.shape} and {hi.shape}")
+    if lo.shape[0] and empty_rows(lo, hi).any():
+        raise ValueError("connected_subsets: the boxes must be non-empty")
+    n_box = lo.shape[0]
+    parent = np.arange(n_box)
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = int(parent[i])
+        return i
+
+    order = np.argsort(lo[:, 0], kind="stable")  # sweep on the first coordinate
+    slo, shi = lo[order], hi[order]
+    for k in range(n_box):
+        end = int(np.searchsorted(slo[:, 0], shi[k, 0], side="right"))  # later boxes starting before hi
+        if end <= k + 1:
+            continue
+        touch = ((slo[k + 1 : end] <= shi[k]) & (slo[k] <= shi[k + 1 : end])).all(axis=1)
+        for j in (k + 1 + np.flatnonzero(touch)).tolist():
+            a, b = root(int(order[k])), root(int(order[j]))
+            if a != b:
+                parent[max(a, b)] = min(a, b)
+    roots = np.array([root(i) for i in range(n_box)], dtype=np.int64)
+    groups = [np.flatnonzero(roots == r) for r in np.unique(roots)]
+    return sorted(groups, key=lambda g: (-g.size, int(g[0])))
+
+
 __all__ = [
     "Paving",
     "PavingTree",
+    "connected_subsets",
     "pave",
 ]

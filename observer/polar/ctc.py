@@ -15,6 +15,13 @@ may lie in the region and clipped to ``[p]``. That is exactly the union hull of 
 smallest and the largest representative in ``[θ]`` with a rigorous enclosure of ``2kπ``. θ of any width
 works; beyond ``|θ| > 2⁵⁰`` (or unbounded) θ is left as is.
 
+At ``ρ = 0``. ``Π`` holds the origin with every angle, ``(0, 0, 0, θ)`` for all ``θ`` (Eq. 3.22: the
+polar map sends ``(0, θ)`` to the origin), so a box whose only points of ``Π`` are at the origin keeps
+them: ``[-1, 1]² × {0} × [0, 1]`` contracts to ``{0}³ × [0, 1]``, and ``[θ]`` is not contracted there.
+codac's ``CtcPolar`` reads θ as ``atan2(y, x)``, undefined at the origin, and returns the empty box on
+such a box; that drops points of ``Π`` (a robot standing on its landmark, range 0, any bearing), so this
+contractor keeps them (``tests/peer``, case ``CtcPolar_origin``).
+
 A box unbounded in both ``[ρ]`` and ``[x]×[y]`` is returned after the sound clipping
 ``|x|, |y| <= ρ <= |(x, y)|`` only (no candidate can be enclosed at infinity).
 
@@ -40,7 +47,8 @@ class CtcPolar(Ctc):
     """Minimal contractor for ``Π = {(x, y, ρ, θ) | x = ρ cos θ, y = ρ sin θ}`` (Eq. 3.22, 3.34).
 
     Acts on batches ``(N, 4)`` with columns ``(x, y, ρ, θ)``. Each face of a non-empty result touches
-    ``Π`` (up to outward rounding), for ``ρ`` of any sign and ``θ`` of any width. The work is one call
+    ``Π`` (up to outward rounding), for ``ρ`` of any sign and ``θ`` of any width; the origin belongs to
+    ``Π`` with every ``θ`` (see the module docstring, "At ρ = 0"). The work is one call
     of the compiled kernel :func:`digslam.observer.core.polar_jit.ctc_polar_batch`.
 
     Args:

@@ -2,10 +2,11 @@
 
 Lives here: :mod:`.record` (``MissionRecord``, the data contract between a simulator or robot and the
 observers), :mod:`.grid` (the observer's grid), :mod:`.digmap` (``DigMap``, the dig zone M-, Sec. 6.3),
-:mod:`.digslam` (offline Dig-SLAM, Alg. 6.2), :mod:`.explored` and :mod:`.explored_sweep` (the explored zone
-as a thick set, App. B.5), :mod:`.landmarks` (landmark localization, Ex. 3.4), :mod:`.shapes` (sonar
-measurement shapes), :mod:`.shape_registration` and :mod:`.shape_slam` (shape SLAM, Sec. 6.4) and
-:mod:`.explicit_slam` (explicit SLAM, Alg. 6.1).
+:mod:`.digslam` (Dig-SLAM's settings, result and tube pieces, and Alg. 6.3 as the thesis writes it),
+:mod:`.explored` and :mod:`.explored_sweep` (the explored zone as a thick set, App. B.5), :mod:`.landmarks`
+(landmark localization, Ex. 3.4), :mod:`.shapes` (sonar measurement shapes), :mod:`.shape_registration` and
+:mod:`.shape_slam` (shape SLAM, Sec. 6.4) and :mod:`.explicit_slam` (explicit SLAM, Alg. 6.1). The offline
+Dig-SLAM observer itself, ``dig_slam``, runs the online filter's kernels: :mod:`digslam.observer.online`.
 
 May import: every folder of :mod:`digslam.observer` except :mod:`~digslam.observer.online`; numpy, scipy.
 """
@@ -18,10 +19,10 @@ from .digslam import (
     DigSlamConfig,
     DigSlamResult,
     dig_readings,
-    dig_slam,
     explored_zone,
     impact_bound,
     odometry_velocity,
+    thesis_dig_slam,
 )
 from .explicit_slam import (
     ExplicitSlamConfig,
@@ -122,7 +123,7 @@ __all__ = [
     "contract_disjunctive",
     "ctc_minus",
     "dig_readings",
-    "dig_slam",
+    "thesis_dig_slam",
     "explicit_slam",
     "explored_disks_grid",
     "explored_disks_thick_sep",

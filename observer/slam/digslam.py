@@ -1,8 +1,11 @@
-"""The offline Dig-SLAM observer (thesis §6.4, Algorithm 6.3, Eq. 6.18–6.24).
+"""Dig-SLAM on a whole record (thesis §6.4, Eq. 6.18–6.24): its settings and result, the pieces that act on a
+tube, and Algorithm 6.3 as the thesis writes it.
 
-From a recorded mission (bounded speed, yaw rate, compass heading and range intervals) Dig-SLAM encloses
-the robot's positions in a tube, proves which cells are free (the dig zone ``M⁻``) and which were
-explored, and iterates the two contractors of the constraint network (6.24) to a fixpoint:
+:func:`~digslam.observer.online.smoother.dig_slam` is the offline observer to use: the fixpoint of every
+contractor of the online filter over the record (its kernels live in :mod:`digslam.observer.online`), never
+less sharp than the filter. :func:`thesis_dig_slam` here is Algorithm 6.3 itself, the reference that
+:func:`~.explicit_slam.explicit_slam` specialises and that the thesis's Fig. 6.13 counts. It iterates the two
+contractors of the constraint network (6.24) to a fixpoint:
 
 1. ``[x](·) := C_d/dt([x](·))`` with ``ẋ = R(ψ) v`` and the body-frame velocity ``v = (v_1, v_2)``
    (Eq. 3.59, 6.12, B.20; Eq. 6.23 is the unicycle ``v_2 = 0``), forward and backward;
@@ -28,7 +31,7 @@ A measured odometry increment ``mean_velocity[k]`` also bounds the gate incremen
 ...     alpha=np.zeros((n, 1)), gamma=np.full((n, 1), np.pi), r_max=np.full((n, 1), 5.0),
 ...     range=np.stack([2 - np.arange(n) * 0.1 - 0.01, 2 - np.arange(n) * 0.1 + 0.01], 1)[:, None],
 ...     no_echo=np.zeros((n, 1), bool), outlier=np.zeros((n, 1), bool))        # a wall at x = 2
->>> res = dig_slam(rec, Grid((-3.0, -3.0), (3.0, 3.0), (120, 120)), [0.0, 0.0], [0.0, 0.0])
+>>> res = thesis_dig_slam(rec, Grid((-3.0, -3.0), (3.0, 3.0), (120, 120)), [0.0, 0.0], [0.0, 0.0])
 >>> res.consistent, bool(res.dig.free[60, 60]), bool(res.dig.free[60, 110])   # origin free, x=2.5 not
 (True, True, False)
 """
@@ -41,7 +44,7 @@ from typing import Any
 import numpy as np
 
 from digslam.observer.core import rounding as rnd
-from digslam.observer.core.config import Config, check_finite_nonneg, check_int, config_dataclass
+from digslam.observer.core.config import Config, check, check_finite_nonneg, check_int, config_dataclass
 from digslam.observer.core.types import Pair
 from digslam.observer.slam.digmap import DigMap
 from digslam.observer.slam.explored import explored_disks_grid, explored_union
@@ -61,17 +64,37 @@ class DigSlamConfig(Config):
         tol: stop when an iteration shrinks the summed gate widths by less than this fraction.
         impacts: apply the impact contractor (Eq. 6.22); without it the result is dead reckoning plus
             digging (the thesis's "before contraction").
-        explored: compute the explored zone of the final tube (App. B).
+        cones: with ``impacts``, also its directional form, each echo's cone meeting ``comp M⁻``
+            (:func:`~digslam.observer.online.smoother.dig_slam` only).
+        cone_every: in the filter pass of ``dig_slam``, the cones every ``cone_every`` steps (as
+            :class:`~digslam.observer.online.observer.OnlineConfig`); its fixpoint sweeps apply them at
+            every step.
+        q: the q-relaxed mode (thesis §2.6.2): at most ``q`` of the range readings of one step miss the truth
+            (``dig_slam`` only; :func:`thesis_dig_slam` refuses ``q > 0``).
+        explored: add the explored-zone proofs of App. B on the final tube (:func:`explored_zone`: clear,
+            proved penumbra, dark). None (default): :func:`thesis_dig_slam` computes them and
+            ``dig_slam`` does not (its explored zone is the filter kernels' certainly and possibly sensed
+            cells from the final boxes; the proofs add nothing to an omnidirectional sensor's and cost
+            about 0.2 ms per step); False: neither (``thesis_dig_slam`` then has no explored zone).
     """
 
     max_iter: int = 10
     tol: float = 5e-3
     impacts: bool = True
-    explored: bool = True
+    cones: bool = True
+    cone_every: int = 4
+    q: int = 0
+    explored: bool | None = None
 
     def __post_init__(self) -> None:
         check_int("max_iter", self.max_iter, 1)
         check_finite_nonneg("tol", self.tol)
+        for name in ("impacts", "cones", "explored"):
+            v = getattr(self, name)
+            ok = isinstance(v, bool | np.bool_) or (v is None and name == "explored")
+            check(ok, name, f"must be a bool{' or None' if name == 'explored' else ''}, got {v!r}")
+        check_int("cone_every", self.cone_every, 1)
+        check_int("q", self.q, 0, " (outliers allowed per step)")
 
 
 @dataclass
@@ -84,12 +107,14 @@ class DigSlamResult:
         tube: the contracted position tube (None when inconsistent).
         dig: the dig zone ``M⁻`` (None when inconsistent).
         explored: the explored zone ``[Z⁻, Z⁺]`` on the grid (App. B), int8 codes of
-            :mod:`.thick.sep` (clear, penumbra, dark, unknown); None when inconsistent.
+            :mod:`.thick.sep` (clear, penumbra, dark, unknown); None when inconsistent (or, for
+            :func:`thesis_dig_slam`, without ``explored``).
         heading: the heading tube used for the velocity (compass and gyro fused).
         iterations: fixpoint iterations run.
         widths: per iteration, gate widths ``(T+1,)`` before the impact contractor, after it, and after
             ``C_d/dt`` (keys ``"before"``, ``"impacts"``, ``"deriv"``); Fig. 6.13.
         dead_reckoning: gate widths of the initial dead-reckoning tube.
+        online_widths: gate widths of the online filter's boxes on the same record (``dig_slam`` only).
     """
 
     consistent: bool
@@ -101,6 +126,13 @@ class DigSlamResult:
     widths: list[dict[str, np.ndarray]] = field(default_factory=list)
     dead_reckoning: np.ndarray | None = None
     explored: np.ndarray | None = None
+    online_widths: np.ndarray | None = None
+
+    def clear_mask(self) -> np.ndarray:
+        """Certified coverage: proved free and certainly explored (``(ny, nx)`` bool)."""
+        if self.dig is None or self.explored is None:
+            raise ValueError("clear_mask: no explored zone (an inconsistent record, or explored=False)")
+        return self.dig.free & (self.explored == CLEAR)
 
 
 def explored_zone(grid: Grid, record: MissionRecord, tube: Tube, heading: Tube) -> np.ndarray:
@@ -190,10 +222,12 @@ def impact_bound(record: MissionRecord) -> np.ndarray:
     return hi.min(axis=1)
 
 
-def dig_slam(
+def thesis_dig_slam(
     record: MissionRecord, grid: Grid, x0_lo: Any, x0_hi: Any, config: DigSlamConfig | None = None
 ) -> DigSlamResult:
-    """Run Dig-SLAM (Algorithm 6.3) on a recorded mission to its fixpoint.
+    """Run Algorithm 6.3 as the thesis writes it on a recorded mission, to its fixpoint (the module
+    docstring; :func:`~digslam.observer.online.smoother.dig_slam` is sharper: it adds the filter's cone
+    contractor, the odometry displacement boxes and the q-relaxed readings).
 
     Args:
         record: a stacked mission of ``T + 1`` samples (see the data contract above).
@@ -208,6 +242,8 @@ def dig_slam(
         ValueError: on a single-step record, or an initial box that is not a 2-d box.
     """
     cfg = config or DigSlamConfig()
+    if cfg.q:
+        raise ValueError("config: thesis_dig_slam has no q-relaxed mode (q must be 0); use dig_slam")
     if record.t.ndim != 1 or len(record) < 2:
         raise ValueError("record: expected a stacked mission of at least two samples")
     x0_lo, x0_hi = np.asarray(x0_lo, dtype=np.float64), np.asarray(x0_hi, dtype=np.float64)
@@ -251,7 +287,7 @@ def dig_slam(
             break
         total = new_total
     res.tube = tube
-    if cfg.explored:
+    if cfg.explored is not False:
         res.explored = explored_zone(grid, record, tube, heading)
     return res
 
@@ -260,7 +296,7 @@ __all__ = [
     "DigSlamConfig",
     "DigSlamResult",
     "dig_readings",
-    "dig_slam",
+    "thesis_dig_slam",
     "explored_zone",
     "impact_bound",
     "odometry_increment",

@@ -35,6 +35,18 @@ WIDER: dict[str, str] = {
         "SepInverse(..., centred=True) is case SepProjc#58: y <= 1.117, tighter than codac's 1.15 "
         "(truth 1.08)."
     ),
+    "CtcInverse_parabolas#110": (
+        "CtcFwdBwd runs the natural form by default (the centred form costs more per call, as for SepProj#55). "
+        "HC4 to a fixpoint paves codac's single connected subset, but its hull is [0.1437, 0.1882] on a0 "
+        "against codac's [0.1492, 0.1824], codac's CtcInverse using the centred form. With centred=True "
+        "(case CtcInverse_parabolasc#111) the hull is [0.14982, 0.18024]: tighter than codac's (truth "
+        "[0.149856, 0.18] on every coordinate)."
+    ),
+    "CtcPolar_origin#112": (
+        "CtcPolar contracts onto Pi of Eq. 3.22, where the origin (x, y, rho) = 0 goes with every theta; "
+        "codac's CtcPolar (its Catan2, atan2 being undefined at the origin) drops the origin and returns the "
+        "empty box on [-1, 1]^2 x {0} x [0, 1]: codac's value misses the points (0, 0, 0, theta) of the set."
+    ),
 }
 
 

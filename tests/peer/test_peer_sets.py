@@ -1,6 +1,8 @@
 """codac's contractor and separator tests re-expressed: ``CtcInverse`` (our :class:`CtcFwdBwd`),
 ``SepInverse``, ``SepTransform``, ``SepProj``, ``CtcSegment`` (our :class:`CtcSegments`), ``CtcPolygon``
-(our :class:`CtcPolygonBoundary`), ``SepPolygon`` and ``SepQInter``.
+(our :class:`CtcPolygonBoundary`), ``SepPolygon``, ``SepQInter`` (ibex's ``qinter`` test), the
+ParabolasExample of ``CtcInverse`` (judged on the hull of its one connected subset) and ``CtcPolar`` at
+``ρ = 0``.
 
 The truth of a contracted box (or of a separator's outer part) is the hull of the box's points in the
 set, of its inner part the hull of the points outside it; both are taken here over a grid of the box
@@ -20,7 +22,9 @@ import numpy as np
 import pytest
 from judge import EMPTY, box_of, judge_box, sampled_hull
 
-from digslam.observer import Box, CtcFwdBwd, Function, Interval, SepInverse, SepProj, SepQInter, sqr
+from digslam.observer import Box, CtcFwdBwd, Function, Interval, SepInverse, SepProj, SepQInter, pave, sqr
+from digslam.observer.polar import CtcPolar
+from digslam.observer.sets import CtcFixPoint, SepBox, SepCtcPair
 from digslam.observer.sets.sep_polygon import CtcSegments, SepPolygon
 from digslam.observer.sets.transforms import SepTransform, Transform
 
@@ -273,6 +277,92 @@ for q, member in ((1, lambda t: -1 <= t <= 1 or 5 <= t <= 6), (0, lambda t: Fals
         pout = [(min(a for a, _ in met), max(b for _, b in met))] if met else [EMPTY]
         sep_case(f"SepQInter_q{q}", SepQInter([s1, s2], q), box, _closure_hull(box[0], outs), pout, member, 0.0,
                  ENDS)  # fmt: skip
+
+
+# ibex's qinter test (codac 1, tests_sep_qinterprojf.cpp): five boxes, the points in at least `need` of them.
+# SepQInter's q counts the sets a point may miss (q = 5 - need); the outer part on a frame holding the five
+# boxes is their box q-intersection: ibex's exact `qinter` (SepQInter's default) or its coordinate-wise
+# `qinter_projf` (exact=False); the inner part is the frame (its corners lie outside the set).
+QBOXES = [
+    [(1, 5), (1, 6)],
+    [(3, 7), (2, 5.5)],
+    [(1.5, 2.5), (4.5, 8)],
+    [(2.5, 5), (0, 4)],
+    [(1.5, 8), (1.5, 3)],
+]
+QFRAME = [(0, 9), (-1, 9)]
+QINTER = {1: [(1, 8), (0, 8)], 2: [(1.5, 7), (1, 6)], 3: [(2.5, 5), (1.5, 4)], 4: [(3, 5), (2, 3)]}
+QPROJF = {1: [(1, 8), (0, 8)], 2: [(1.5, 7), (1, 6)], 3: [(1.5, 5), (1.5, 5.5)], 4: [(2.5, 5), (2, 3)]}
+QCORNERS = tuple((a, b) for a in sorted({v for bx in QBOXES for v in bx[0]})
+                 for b in sorted({v for bx in QBOXES for v in bx[1]}))  # fmt: skip
+
+
+def _in_boxes(need: int) -> Callable[..., bool]:
+    return lambda a, b: sum(lo <= a <= hi and c <= b <= d for (lo, hi), (c, d) in QBOXES) >= need
+
+
+for exact, table in ((True, QINTER), (False, QPROJF)):
+    for need, peer in table.items():
+        sep = SepQInter([SepBox(Box(bx)) for bx in QBOXES], 5 - need, exact=exact)
+        sep_case(f"SepQInter_{'qinter' if exact else 'projf'}{need}", sep, QFRAME, QFRAME, peer, _in_boxes(need),
+                 0.0, QCORNERS)  # fmt: skip
+# codac 1's SepQInterProjF test: q = 4 of the same five separators (in any one box), on [2, 4] × [3, 5]
+for exact in (True, False):
+    sep_case("SepQInter_projf_sep", SepQInter([SepBox(Box(bx)) for bx in QBOXES], 4, exact=exact),
+             [(2, 4), (3, 5)], [EMPTY, EMPTY], [(2, 4), (3, 5)], _in_boxes(1), 0.0, QCORNERS)  # fmt: skip
+
+
+# ParabolasExample (codac2_tests_CtcInverse): two Bézier patches meet along a curve; CtcInverse of their
+# difference = 0 paved at 0.01 leaves one connected subset. The first patch is z = x - x²/2 over
+# (x, y) = (2a0, 2a1), the second z = c0 - 2 (c0 - c1) s (1 - s) over (x, y) = (2a3, 2a2) with c0, c1 the
+# doubles 0.55 and -0.45: the curve is a0 = a3 = u, a1 = a2 = w with 2u(1 - u) = c0 - 2(c0 - c1) w(1 - w),
+# inside [0.05, 0.18]² on (u, w); its hull is [u*, 0.18]⁴, u* the u at w = 0.18.
+PARAB_P = (((0, 0, 0), (1, 0, 1), (2, 0, 0)), ((0, 2, 0), (1, 2, 1), (2, 2, 0)))
+PARAB_Q = (((0, 0, 0.55), (0, 1, -0.45), (0, 2, 0.55)), ((2, 0, 0.55), (2, 1, -0.45), (2, 2, 0.55)))
+PARAB_X0 = [(0, 1), (0, 1), (0.05, 0.18), (0.05, 0.18)]
+PARAB_PEER = [(0.149199, 0.182388), (0.148306, 0.1826), (0.148054, 0.18), (0.148732, 0.18)]
+
+
+def _patch(u: Any, v: Any, pts: Any) -> list[Any]:
+    def bez(row: Any, k: int) -> Any:
+        return sqr(1 - u) * row[0][k] + 2 * u * (1 - u) * row[1][k] + sqr(u) * row[2][k]
+
+    return [(1 - v) * bez(pts[0], k) + v * bez(pts[1], k) for k in range(3)]
+
+
+def _parab_h(a: Any) -> list[Any]:
+    p, q = _patch(a[0], a[1], PARAB_P), _patch(a[2], a[3], PARAB_Q)
+    return [p[k] - q[k] for k in range(3)]
+
+
+def _parab_truth() -> list[tuple[Any, Any]]:
+    with mpmath.workprec(200):
+        c0, c1, top = mpmath.mpf(0.55), mpmath.mpf(-0.45), mpmath.mpf(0.18)
+        rhs = c0 - 2 * (c0 - c1) * top * (1 - top)  # 2u(1 - u) at w = 0.18 (the smallest)
+        u_min = (1 - mpmath.sqrt(1 - 2 * rhs)) / 2
+        return [(u_min, top)] * 4
+
+
+def _parab_ours(ctc: Any) -> Any:
+    subsets = pave(Box(PARAB_X0), SepCtcPair(None, ctc), 0.01, ratio=0.49).connected_subsets()
+    assert len(subsets) == 1, f"{len(subsets)} connected subsets (codac: 1)"
+    (lo, hi) = subsets[0]
+    return [(float(a), float(b)) for a, b in zip(lo.min(axis=0), hi.max(axis=0))]
+
+
+PARAB_F = Function(_parab_h, n=4)
+# natural form: HC4 to a fixpoint; centred form: one pass, as codac's CtcInverse
+for centred in (False, True):
+    c = CtcFwdBwd(PARAB_F, Box([(0, 0)] * 3), centred=centred)
+    c = c if centred else CtcFixPoint(c, ratio=1e-3)
+    case(f"CtcInverse_parabolas{'c' if centred else ''}", lambda c=c: _parab_ours(c), PARAB_PEER, _parab_truth,
+         1e-4)  # fmt: skip
+
+
+# CtcPolar at ρ = 0: the origin with every θ is in Π (Eq. 3.22); codac's CtcPolar (its Catan2) drops the
+# origin and returns the empty box here (codac 2.0, run apart from this process)
+case("CtcPolar_origin", lambda: box_of(CtcPolar()(Box([(-1, 1), (-1, 1), (0, 0), (0, 1)]))), [EMPTY] * 4,
+     lambda: [(mpmath.mpf(0), mpmath.mpf(0))] * 3 + [(mpmath.mpf(0), mpmath.mpf(1))])  # fmt: skip
 
 
 @pytest.mark.parametrize(("name", "ours", "peer", "truth", "tol"), CASES, ids=[c[0] for c in CASES])

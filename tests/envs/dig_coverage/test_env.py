@@ -303,7 +303,8 @@ def test_sb3_ppo_learns_a_few_hundred_steps() -> None:
 
 def test_offline_observer_on_a_re_indexed_env_mission_contains_the_truth() -> None:
     from digslam.envs import record_episode
-    from digslam.observer.slam.digslam import DigSlamConfig, dig_slam
+    from digslam.observer.online.smoother import dig_slam
+    from digslam.observer.slam.digslam import DigSlamConfig
     from digslam.observer.slam.grid import Grid
 
     env = ExploreEnv(world="rocks", noise={"model": "adversarial"})

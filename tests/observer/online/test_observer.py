@@ -14,9 +14,9 @@ from digslam.envs.sim.missions import loop_mission
 from digslam.envs.sim.sensors import SensorSuite
 from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam
 from digslam.observer.online.pose_jit import cos_sin
+from digslam.observer.online.smoother import dig_slam
 from digslam.observer.online.window import WindowDigMap, mark_possibly_sensed
 from digslam.observer.slam.digmap import DigMap
-from digslam.observer.slam.digslam import dig_slam
 from digslam.observer.slam.grid import Grid
 from digslam.observer.slam.record import MissionRecord
 from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA

@@ -10,7 +10,8 @@ from example_loader import load
 
 from digslam.envs.sim.missions import loop_mission
 from digslam.envs.sim.sensors import SensorSuite
-from digslam.observer.slam.digslam import DigSlamConfig, dig_slam
+from digslam.observer.slam.digslam import DigSlamConfig
+from digslam.observer.slam.digslam import thesis_dig_slam as dig_slam
 from digslam.observer.slam.explicit_slam import (
     ExplicitSlamConfig,
     MapFunction,
