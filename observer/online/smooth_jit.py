@@ -50,11 +50,23 @@ __all__ = [
 ]
 
 
-#: A stacked record of ``T + 1`` steps as the kernels read it (C-contiguous float64, ``no_echo`` bool): the
-#: fields of :class:`.dig_jit.StepRecord` with a leading time axis, ``t`` in place of ``dt``.
-RecordArrays = NamedTuple(
-    "RecordArrays", [("t", np.ndarray), *((f, np.ndarray) for f in StepRecord._fields[1:])]
-)
+class RecordArrays(NamedTuple):
+    """A stacked record of ``T + 1`` steps as the kernels read it (C-contiguous float64, ``no_echo`` bool):
+    the fields of :class:`.dig_jit.StepRecord` with a leading time axis, ``t`` (``(T + 1,)``) in place of
+    ``dt`` (the same fields as :class:`~digslam.observer.slam.record.MissionRecord`, ``ranges`` for its
+    ``range``)."""
+
+    t: np.ndarray
+    speed: np.ndarray  # (T + 1, 2), then yaw_rate, heading and lateral
+    lateral: np.ndarray
+    yaw_rate: np.ndarray
+    heading: np.ndarray
+    alpha: np.ndarray  # (T + 1, n), then gamma, r_max and no_echo
+    gamma: np.ndarray
+    r_max: np.ndarray
+    ranges: np.ndarray  # (T + 1, n, 2)
+    no_echo: np.ndarray
+    mean_velocity: np.ndarray  # (T + 1, 2, 2)
 
 
 def record_arrays(rec: MissionRecord) -> RecordArrays:

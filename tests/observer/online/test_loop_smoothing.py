@@ -34,6 +34,19 @@ def test_audit_with_loop_smoothing(world: str, seed: int) -> None:
         env.close()
 
 
+@pytest.mark.expensive
+@pytest.mark.parametrize("world", ["room", "rocks", "caves", "rooms"])
+def test_audit_with_loop_smoothing_long(world: str) -> None:
+    """1200 hostile steps with frequent passes (threshold 5 %) and a history of 200 steps."""
+    env = gym.make("digslam/DigCoverage-v0", world=world, online={"loop_smoothing": 0.05, "history": 200})
+    try:
+        seed = 961100 + len(world)
+        aud = audit_episode(env, seed, random_actions(np.random.default_rng(seed), 1200))
+        assert aud.k >= 600 and _filter(env).history.n <= 200
+    finally:
+        env.close()
+
+
 def _filter(env: gym.Env) -> OnlineDigSlam:
     e = env
     while not hasattr(e, "filter"):
