@@ -180,6 +180,8 @@ class OnlineDigSlam:
         self._ring: deque = deque(maxlen=self.config.smoothing_window + 1)
         impacts = self.config.impacts
         self._impacts, self._q = (2 if self.config.cones else 1) if impacts else 0, int(self.config.q)
+        self._window, self._cone_every = int(self.config.smoothing_window), int(self.config.cone_every)
+        self._t_prev = -math.inf
         self._blank()
 
     def _blank(self) -> None:
@@ -242,11 +244,15 @@ class OnlineDigSlam:
 
     def update(self, rec: MissionRecord) -> None:
         """Fold in the next single-step record (does nothing once inconsistent)."""
-        if self._prev is None:
+        prev = self._prev
+        if prev is None:
             raise ValueError("rec: call reset() before update()")
         if not isinstance(rec, MissionRecord) or rec.t.ndim != 0:
             raise ValueError("rec: expected a single-step MissionRecord (scalar t)")
-        dt = self._step_dt(rec, self._prev)
+        t = float(rec.t)
+        if rec.alpha.shape[-1] != prev.alpha.shape[-1] or not t > self._t_prev:
+            self._step_dt(rec, prev)  # raises, naming what is wrong
+        dt = t - self._t_prev
         if not self.consistent:
             return
         start = time.perf_counter()
@@ -258,21 +264,22 @@ class OnlineDigSlam:
         # the kernel overwrites copies of the state: the arrays handed out are never changed
         lo, hi, psi = self.pose_lo.copy(), self.pose_hi.copy(), np.array((self.heading_lo, self.heading_hi))
         impacts = self._impacts
-        if impacts == 2 and self.steps % self.config.cone_every:
+        if impacts == 2 and self.steps % self._cone_every:
             impacts = 1  # the cones every cone_every steps (skipping a contractor claims nothing false)
         code, r0, r1, c0, c1, d = filter_step_flat(self._cells_t, self._frame_t, step, lo, hi, psi, impacts,
                                                    self._q)  # fmt: skip
         if code:
             return self._fail(start)
         self.pose_lo, self.pose_hi = lo, hi
-        self.heading_lo, self.heading_hi = float(psi[0]), float(psi[1])
-        self._touch(r0, r1, c0, c1)
-        if self.config.smoothing_window:
+        self.heading_lo, self.heading_hi = psi.tolist()
+        if r0 < r1 and c0 < c1:
+            self._touch(r0, r1, c0, c1)
+        if self._window:
             band = (self.heading_lo, self.heading_hi)
             self._ring.append([StepRecord(*step), self.pose_lo.copy(), self.pose_hi.copy(), band, d])
-        self._prev = rec
+        self._prev, self._t_prev = rec, t
         self.steps += 1
-        if self.config.smoothing_window and not self._smooth():
+        if self._window and not self._smooth():
             return self._fail(start)
         h = self.history
         if h is not None:
@@ -323,7 +330,7 @@ class OnlineDigSlam:
         if self.history is not None:
             self.history.push(step, float(rec.t), self.pose_lo, self.pose_hi, psi, None, self.cells,
                               self.dig.frame)  # fmt: skip
-        self._prev = rec
+        self._prev, self._t_prev = rec, float(rec.t)
         self.steps += 1
 
     def _smooth(self) -> bool:

@@ -38,7 +38,8 @@ def test_audit_with_loop_smoothing(world: str, seed: int) -> None:
 @pytest.mark.parametrize("world", ["room", "rocks", "caves", "rooms"])
 def test_audit_with_loop_smoothing_long(world: str) -> None:
     """1200 hostile steps with frequent passes (threshold 5 %) and a history of 200 steps."""
-    env = gym.make("digslam/DigCoverage-v0", world=world, online={"loop_smoothing": 0.05, "history": 200})
+    env = gym.make("digslam/DigCoverage-v0", world=world, target=1.0,
+                   online={"loop_smoothing": 0.05, "history": 200})  # fmt: skip
     try:
         seed = 961100 + len(world)
         aud = audit_episode(env, seed, random_actions(np.random.default_rng(seed), 1200))
