@@ -121,7 +121,8 @@ def dig_slam(
         A :class:`~digslam.observer.slam.digslam.DigSlamResult`; check ``consistent`` before using the sets.
 
     Raises:
-        ValueError: on a single-step record, a grid that is not a Grid, or a bad initial box.
+        ValueError: on a single-step record, a grid that is not a Grid, a bad initial box, or
+            ``explored=True`` with ``q > 0``.
     """
     cfg = config or DigSlamConfig()
     if not isinstance(record, MissionRecord) or record.t.ndim != 1 or len(record) < 2:
@@ -130,6 +131,8 @@ def dig_slam(
         raise ValueError(f"grid: expected a Grid, got {type(grid).__name__}")
     x0 = _check_start(grid, x0_lo, x0_hi)
     t, n, q = record.t, len(record), int(cfg.q)
+    if cfg.explored and q:
+        raise ValueError("config: explored=True (the App. B proofs) trusts every reading; it needs q = 0")
     heading = heading_from_compass(t, record.heading[:, 0], record.heading[:, 1],
                                    record.yaw_rate[1:, 0], record.yaw_rate[1:, 1])  # fmt: skip
     if heading.is_empty():  # compass and gyro contradict each other

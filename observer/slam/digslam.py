@@ -75,7 +75,8 @@ class DigSlamConfig(Config):
             proved penumbra, dark). None (default): :func:`thesis_dig_slam` computes them and
             ``dig_slam`` does not (its explored zone is the filter kernels' certainly and possibly sensed
             cells from the final boxes; the proofs add nothing to an omnidirectional sensor's and cost
-            about 0.2 ms per step); False: neither (``thesis_dig_slam`` then has no explored zone).
+            about 0.2 ms per step); False: neither (``thesis_dig_slam`` then has no explored zone). The
+            proofs trust every reading: ``dig_slam`` refuses ``explored=True`` with ``q > 0``.
     """
 
     max_iter: int = 10

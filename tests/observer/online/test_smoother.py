@@ -104,4 +104,6 @@ def test_bad_input_gets_one_line() -> None:
         dig_slam(ep.records, None, [0.0, 0.0], [0.0, 0.0])  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="q"):
         DigSlamConfig(q=-1)
+    with pytest.raises(ValueError, match="explored"):
+        dig_slam(ep.records, grid, [0.0, 0.0], [0.0, 0.0], DigSlamConfig(q=1, explored=True))
     env.close()
