@@ -16,8 +16,8 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+from digslam.observer.cache import origin as _origin
 from digslam.observer.core import compat as _compat
-from digslam.observer.core import origin as _origin
 
 _origin.warn_if_shadowed(__name__)
 
@@ -27,7 +27,7 @@ MOVED = {
     "train": "learning.train", "extractor": "learning.extractor", "sweep": "learning.sweep",
     "sweep_config": "learning.sweep_config", "evaluate": "evaluation.evaluate",
     "pictures": "evaluation.pictures",
-    "ray_eval": "evaluation.ray_eval", "warmup": "cli.warmup", "origin": "digslam.observer.core.origin",
+    "ray_eval": "evaluation.ray_eval", "warmup": "cli.warmup", "origin": "digslam.observer.cache.origin",
 }  # fmt: skip
 _compat.install_aliases(__name__, MOVED)
 

@@ -31,8 +31,8 @@ from digslam.envs.sim.generators import (
 )
 from digslam.envs.sim.sensors import SensorSuite
 from digslam.envs.sim.world import World
+from digslam.observer.cache import origin as _origin  # a shadowing source folder is reported in one line
 from digslam.observer.core import compat as _compat
-from digslam.observer.core import origin as _origin  # a shadowing source folder is reported in one line
 
 _origin.warn_if_shadowed(__name__)
 

@@ -7,6 +7,11 @@ Dig-SLAM observer (:func:`dig_slam`, :class:`DigMap` on a :class:`Grid`), all ac
 two float64 arrays ``lo, hi`` of shape ``(N, n)``.
 """
 
+# ruff: noqa: E402  (the kernel caches are prepared before any kernel module is imported)
+from digslam.observer import cache
+
+cache.prepare()  # stale caches cleared, the kernel store first, the cold-start notice registered
+
 from digslam.observer.core import arith, boxes, compat, rounding, trig
 from digslam.observer.core.interval import Box, Interval, IntervalArray, dot
 from digslam.observer.expr.expr import Expr, Function

@@ -60,7 +60,7 @@ def _one_line_warning(message: Warning | str, category: type[Warning], filename:
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``digslam`` console script: a mistake in the user's input is one line on stderr
     and exit status 2, never a traceback."""
-    from digslam.observer.core import origin
+    from digslam.observer.cache import origin
 
     origin.warn_if_shadowed()
     args = build_parser().parse_args(argv)

@@ -80,13 +80,13 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "warmup",
-        help="compile the numba kernels once (about 50 s on 2 cores)",
-        description="Compile the numba kernels of the environments, the observer and the "
-        "interval library into their on-disk cache, in parallel processes, so that the first "
-        "demo, reset or paving does not wait for them. Run it once after installing. Measured on "
-        "2 cores with an empty cache: 50 s (75 s of CPU; the robot job 14 s, the interval library "
-        "36 s, the observer 50 s, two jobs at a time); with the kernels cached it only loads them "
-        "(about 4 s).",
+        help="compile the numba kernels into the kernel store (pip install does it; a minute on 2 cores)",
+        description="Compile the numba kernels of the environments, the observer, the interval library "
+        "and the planning agents into the kernel store beside their sources (or numba's cache where the "
+        "store is off), in parallel processes, so that the first demo, reset or paving does not wait for "
+        "them. pip install runs it on the wheel it builds; run it after an editable install, or after "
+        "installing with DIGSLAM_BUILD_KERNELS=0. Measured on 2 cores with nothing compiled: 55 s "
+        "(two jobs at a time); with the kernels stored it only loads them (a few seconds).",
     )
     p.add_argument(
         "--jobs", type=int, default=None, help="parallel processes (default: the CPU count, at most 3)"

@@ -14,7 +14,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from digslam.observer.core.scalar_jit import njit
 
 
 @njit(cache=True)

@@ -4,13 +4,11 @@ kernel primitives.
 Lives here: :mod:`.rounding` (the one place where rounding direction is decided, Sec. 2.2), :mod:`.arith` and
 :mod:`.trig` (natural inclusion functions on ``(lo, hi)`` arrays, Sec. 2.3), :mod:`.boxes` (batch-box
 helpers), :mod:`.interval` (the user-facing ``Interval``/``IntervalArray``/``Box``), :mod:`.types` (the shared
-aliases ``Pair``, ``Batch``), :mod:`.config` (the one config base), :mod:`.cache` (the stale-kernel guard) and
-:mod:`.origin` (which copy of ``digslam`` was imported). Compiled kernels: :mod:`.scalar_jit` (numba's
-``njit``
-with the project's settings and every scalar outward-rounded primitive), :mod:`.polar_ops_jit` and
-:mod:`.polar_jit` (the minimal polar contractor, Sec. 4.3.2, a primitive of the expressions' ``atan2``
-backward step), :mod:`.angles_jit` (the axis directions an angle range may hold) and :mod:`.grid_jit` (the
-window of grid cells a box meets).
+aliases ``Pair``, ``Batch``) and :mod:`.config` (the one config base). Compiled kernels:
+:mod:`.scalar_jit` (numba's ``njit`` with the project's settings and every scalar outward-rounded
+primitive), :mod:`.polar_ops_jit` and :mod:`.polar_jit` (the minimal polar contractor, Sec. 4.3.2, a
+primitive of the expressions' ``atan2`` backward step), :mod:`.angles_jit` (the axis directions an angle
+range may hold) and :mod:`.grid_jit` (the window of grid cells a box meets).
 
 May import: numpy, numba and the standard library; nothing else of ``digslam``.
 
@@ -25,15 +23,9 @@ May import: numpy, numba and the standard library; nothing else of ``digslam``.
    ``iexp``...) lives in :mod:`.scalar_jit`.
 4. A kernel that needs more than about ten inputs takes them as named tuples (``typing.NamedTuple``, which
    numba passes as records) built by its Python caller, not as packed arrays read by position.
-5. Kernels are cached on disk (``cache=True``). numba's cache checks only the defining file, so
-   :mod:`.cache` hashes every kernel source of the project at import and clears the caches when any of
-   them changed: an edit never runs old compiled code.
+5. Kernels are cached on disk (``cache=True``) in the kernel store, stamped with a digest of every
+   kernel source (:mod:`digslam.observer.cache`): an edit never runs old compiled code.
 """
-
-# ruff: noqa: E402  (the guard runs before the kernel modules are imported)
-from . import cache
-
-cache.guard()  # before any kernel is loaded: an edited kernel source never runs old compiled code
 
 from .angles_jit import (
     axes_in,

@@ -38,7 +38,6 @@ from typing import Any
 import numba
 import numpy as np
 
-from digslam.observer.core.cache import install as _install_compile_notice
 from digslam.observer.core.rounding import LIBM_ULPS
 
 __all__ = ["LIBM_ULPS", "njit", "dn", "up", "wdn", "wup", "add_dn", "add_up", "sub_dn", "sub_up",
@@ -46,7 +45,6 @@ __all__ = ["LIBM_ULPS", "njit", "dn", "up", "wdn", "wup", "add_dn", "add_up", "s
            "imul", "isqr", "idiv", "ixdiv", "isqrt", "iexp", "ilog", "ipown", "iabs"]  # fmt: skip
 
 _INF = math.inf
-_install_compile_notice()  # a cold start says once that it compiles (numba cache miss), on stderr
 
 
 def njit(*args: Any, **kwargs: Any) -> Any:

@@ -245,7 +245,7 @@ def test_ctrl_c_during_train_keeps_a_checkpoint(tmp_path) -> None:  # type: igno
 def test_shadowing_source_folder_is_reported_in_one_line(tmp_path) -> None:  # type: ignore[no-untyped-def]
     import shutil
 
-    from digslam.observer.core import origin
+    from digslam.observer.cache import origin
 
     if origin.installed_root() is None:
         pytest.skip("digslam is not installed")

@@ -1,4 +1,4 @@
-"""The stale-kernel guard (``digslam.observer.core.cache``): an edited kernel source never runs old code.
+"""The stale-kernel guard (``digslam.observer.cache.guard``): an edited kernel source never runs old code.
 
 numba's cache checks only the file that defines a kernel. The hazard, reproduced: kernel ``a`` of
 ``a_jit.py`` calls kernel ``b`` of ``b_jit.py``; after ``b_jit.py`` changes, a fresh process still runs the
@@ -12,7 +12,7 @@ import sys
 import textwrap
 from pathlib import Path
 
-from digslam.observer.core import cache
+from digslam.observer.cache import guard as cache
 
 A = """
 from numba import njit
@@ -34,7 +34,7 @@ import sys
 sys.path.insert(0, {root!r})
 if {guarded}:
     from pathlib import Path
-    from digslam.observer.core import cache
+    from digslam.observer.cache import guard as cache
     cache.guard([Path({root!r})], Path({root!r}) / "stamp")
 from a_jit import a
 print(a(1.0))
