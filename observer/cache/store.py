@@ -64,7 +64,7 @@ def folder(py_file: str | os.PathLike[str], base: Path | None = None) -> Path | 
     base = root() if base is None else base
     if base is None:
         return None
-    path = Path(os.path.abspath(py_file))
+    path = Path(py_file).resolve()  # ROOTS are resolved too (a venv may reach site-packages by a link)
     if not any(path.is_relative_to(r) for r in cache.ROOTS):
         return None
     return base / path.parent.relative_to(PACKAGE) / FOLDER
