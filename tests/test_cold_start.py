@@ -1,4 +1,5 @@
-"""The cold-start notice (:func:`digslam.observer.cache.install`) and the cold README example."""
+"""The cold-start notice (:func:`digslam.observer.cache.notice.install`), the cold README example and the
+README example just after an install (the kernel store built)."""
 
 from __future__ import annotations
 

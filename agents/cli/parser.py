@@ -85,7 +85,7 @@ def build_parser() -> argparse.ArgumentParser:
         "and the planning agents into the kernel store beside their sources (or numba's cache where the "
         "store is off), in parallel processes, so that the first demo, reset or paving does not wait for "
         "them. pip install runs it on the wheel it builds; run it after an editable install, or after "
-        "installing with DIGSLAM_BUILD_KERNELS=0. Measured on 2 cores with nothing compiled: 55 s "
+        "installing with DIGSLAM_BUILD_KERNELS=0. Measured on 2 cores with nothing compiled: 67 s "
         "(two jobs at a time); with the kernels stored it only loads them (a few seconds).",
     )
     p.add_argument(

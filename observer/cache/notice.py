@@ -24,7 +24,7 @@ import sys
 from typing import Any, TextIO
 
 #: Seconds a cold start spends compiling, by what compiles first (measured, 2 cores, empty numba cache).
-ESTIMATES = {"interval": 10, "env": 45}
+ESTIMATES = {"interval": 10, "env": 70}
 #: Module prefixes whose first compilation means the environment path (the rest is the interval library).
 ENV_PREFIXES = ("digslam.envs", "digslam.agents", "digslam.observer.online")
 
