@@ -101,9 +101,7 @@ def fresh_cache() -> str:
     """A new empty ``NUMBA_CACHE_DIR`` holding the stale-kernel guard's current stamp."""
     from digslam.observer import cache
 
-    folder = tempfile.mkdtemp(prefix="digslam-cold-")
-    Path(folder, cache.STAMP).write_text(cache.digest(cache.kernel_sources()) + "\n")
-    return folder
+    return str(cache.empty_cache(tempfile.mkdtemp(prefix="digslam-cold-")))
 
 
 def build_store(folder: str, jobs: tuple[str, ...]) -> float:
@@ -171,13 +169,14 @@ def main() -> None:
             shutil.rmtree(folder, ignore_errors=True)
         return
     from digslam.agents.cli.warmup import JOBS
+    from digslam.observer.cache import store as cache_store
 
     entries = args.entries or (["contract"] if args.quick else list(ENTRIES))
     results, first = {}, {}
     with tempfile.TemporaryDirectory(prefix="digslam-store-") as store:
         jobs = ("interval",) if args.quick else JOBS
         built = build_store(store, jobs)
-        n_files = sum(1 for p in Path(store).rglob("__kernels__/*") if p.suffix in (".nbi", ".nbc"))
+        n_files = len(cache_store.files(Path(store)))
         print(f"store: {n_files} files built in {built:.1f} s ({', '.join(jobs)})")
         for entry in entries:
             results[entry] = cold, warm, cold_cpu, warm_cpu = cold_then_warm(entry, store)

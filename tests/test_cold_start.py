@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import io
 import os
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -84,17 +83,16 @@ def _readme_twice(kernel_store: str, build: bool = False) -> tuple[tuple[float, 
     """``(seconds, stderr)`` of the README example in a fresh process with an empty numba cache and the kernel
     store ``kernel_store``, then again; with ``build``, the store is filled first as ``pip install`` does
     (``digslam warmup``'s interval job)."""
-    with tempfile.TemporaryDirectory() as folder:
-        # the guard's stamp, so that it does not clear the shared caches of the source tree
-        Path(folder, cache.STAMP).write_text(cache.digest(cache.kernel_sources()) + "\n")
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = str(cache.empty_cache(Path(tmp, "numba")))
         env = {**os.environ, "NUMBA_CACHE_DIR": folder, "DIGSLAM_KERNEL_STORE": kernel_store,
                "DIGSLAM_COMPILE_NOTICE": "1"}  # stderr is a pipe  # fmt: skip
-        if build:
+        if build:  # with a numba cache of its own, so that the measured runs start from an empty one
             code = "import sys; from digslam.agents.cli.warmup import build; sys.exit(build(('interval',)))"
-            subprocess.run([sys.executable, "-c", code], env=env, cwd=folder, capture_output=True, check=True)
-            shutil.rmtree(folder)
-            os.mkdir(folder)
-            Path(folder, cache.STAMP).write_text(cache.digest(cache.kernel_sources()) + "\n")
+            env_build = {**env, "NUMBA_CACHE_DIR": str(cache.empty_cache(Path(tmp, "build")))}
+            subprocess.run(
+                [sys.executable, "-c", code], env=env_build, cwd=tmp, capture_output=True, check=True
+            )
         runs = []
         for _ in range(2):
             t0 = time.perf_counter()

@@ -112,6 +112,16 @@ def cache_dirs(py_file: Path) -> list[Path]:
     return [dirs[0] if d == py_file.parent / "__pycache__" else d / _subpath(py_file) for d in dirs]
 
 
+def empty_cache(folder: str | os.PathLike[str]) -> Path:
+    """Make ``folder`` an empty ``NUMBA_CACHE_DIR`` that already holds the current stamp, so that a process
+    pointed at it compiles (or loads from the kernel store) without :func:`guard` clearing the caches of
+    every other folder (an unstamped folder would look like an edit)."""
+    path = Path(folder)
+    path.mkdir(parents=True, exist_ok=True)
+    (path / STAMP).write_text(project_digest() + "\n")
+    return path
+
+
 def stamp_path() -> Path:
     """Where the digest is kept: ``NUMBA_CACHE_DIR`` if set, else beside this file's caches (if writable),
     else numba's user-wide cache folder."""
@@ -168,5 +178,5 @@ def guard(roots: Iterable[Path] = ROOTS, stamp: Path | None = None) -> bool:
     return True
 
 
-__all__ = ["PACKAGE", "ROOTS", "STAMP", "cache_dirs", "clear", "digest", "guard", "kernel_sources",
-           "project_digest", "stamp_path"]  # fmt: skip
+__all__ = ["PACKAGE", "ROOTS", "STAMP", "cache_dirs", "clear", "digest", "empty_cache", "guard",
+           "kernel_sources", "project_digest", "stamp_path"]  # fmt: skip

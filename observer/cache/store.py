@@ -38,7 +38,7 @@ from typing import Any
 
 from numba.core import caching
 
-from digslam.observer.cache import guard as cache
+from digslam.observer.cache import guard
 
 #: The folder beside each kernel source that holds its compiled kernels.
 FOLDER = "__kernels__"
@@ -47,7 +47,7 @@ SWITCH = "DIGSLAM_KERNEL_STORE"
 #: The file, in the store folder of this module, that says how and when the store was built.
 MANIFEST = "digslam-kernels.json"
 #: The folder that holds ``observer/``, ``envs/`` and ``agents/`` (``site-packages/digslam`` or a checkout).
-PACKAGE = cache.PACKAGE
+PACKAGE = guard.PACKAGE
 
 
 def root() -> Path | None:
@@ -65,7 +65,7 @@ def folder(py_file: str | os.PathLike[str], base: Path | None = None) -> Path | 
     if base is None:
         return None
     path = Path(py_file).resolve()  # ROOTS are resolved too (a venv may reach site-packages by a link)
-    if not any(path.is_relative_to(r) for r in cache.ROOTS):
+    if not any(path.is_relative_to(r) for r in guard.ROOTS):
         return None
     return base / path.parent.relative_to(PACKAGE) / FOLDER
 
@@ -76,7 +76,7 @@ def stamp() -> str:
     version in each index, and each numba release pins its llvmlite)."""
     import numpy
 
-    return f"{cache.project_digest()} numpy-{numpy.__version__}"
+    return f"{guard.project_digest()} numpy-{numpy.__version__}"
 
 
 class StoreLocator(caching.InTreeCacheLocator):  # type: ignore[misc]
@@ -112,7 +112,7 @@ def files(base: Path | None = None) -> list[Path]:
     if base is None:
         return []
     found: list[Path] = []
-    for r in cache.ROOTS:
+    for r in guard.ROOTS:
         sub = base / r.relative_to(PACKAGE)
         found += [p for p in sub.rglob(f"{FOLDER}/*") if p.suffix in (".nbi", ".nbc")]
     return sorted(found)

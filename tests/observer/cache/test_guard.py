@@ -84,3 +84,9 @@ def test_guard_keeps_caches_when_nothing_changed(tmp_path: Path) -> None:
 def test_the_project_sources_are_all_hashed() -> None:
     names = {p.name for p in cache.kernel_sources()}
     assert {"scalar_jit.py", "tape_jit.py", "dig_jit.py", "arc_jit.py", "robot_jit.py"} <= names
+
+
+def test_an_empty_cache_folder_is_stamped_so_the_guard_clears_nothing(tmp_path: Path) -> None:
+    folder = cache.empty_cache(tmp_path / "numba")
+    assert [p.name for p in folder.iterdir()] == [cache.STAMP]
+    assert cache.guard(stamp=folder / cache.STAMP) is False  # the current digest: nothing to clear

@@ -41,8 +41,7 @@ print(json.dumps({"sum": iadd(0.1, 0.2, 1.0, 1.0), "compiled": compiled}))
 def _run(tmp: Path, kernel_store: str) -> dict:
     env = {**os.environ, "DIGSLAM_KERNEL_STORE": kernel_store, "NUMBA_CACHE_DIR": str(tmp / "numba"),
            "DIGSLAM_COMPILE_NOTICE": "0"}  # fmt: skip
-    (tmp / "numba").mkdir(exist_ok=True)  # the guard's stamp, so that it leaves the shared caches alone
-    (tmp / "numba" / cache.STAMP).write_text(cache.project_digest() + "\n")
+    cache.empty_cache(tmp / "numba")  # stamped, so that the guard leaves the shared caches alone
     out = subprocess.run([sys.executable, "-c", RUN], env=env, capture_output=True, text=True, timeout=600,
                          check=True, cwd=tmp)  # fmt: skip
     return json.loads(out.stdout.strip().splitlines()[-1])
