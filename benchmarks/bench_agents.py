@@ -1,8 +1,9 @@
 """The coverage benchmark: every agent on the test levels of every generator, certified coverage uncapped.
 
 Every baseline of :data:`digslam.agents.baselines.registry.BASELINES` (and the shipped learned agent
-``agents/data/goals_attention.zip``, row ``ppo``, and the low-level PPO ``agents/data/ppo_digcoverage.zip``,
-row ``ppo_lowlevel``, when they exist, each on the env keywords of its ``.json`` sidecar: they change the
+``agents/data/goals_attention.zip``, row ``ppo``, the learned chooser of the map predictor's gains
+``agents/data/goals_predictive.zip``, row ``predictive_chooser``, and the low-level PPO
+``agents/data/ppo_digcoverage.zip``, row ``ppo_lowlevel``, when they exist, each on the env keywords of its ``.json`` sidecar: they change the
 observation, not the levels) runs on the same ``--maps`` levels of each generator of
 :data:`digslam.agents.evaluation.suite.GENERATORS` (room, rocks, caves, rooms): the first seeds of the test
 split (``digslam.envs.splits``), ``target=1.0`` (no early end), ``--steps`` steps
@@ -32,7 +33,7 @@ baseline with its paired bootstrap 95 % interval), writes ``leaderboard.md``, ``
 ``--model`` takes any model of ``digslam train``, a goal-selection MaskablePPO model included.
 
 Usage: ``python benchmarks/bench_agents.py [--quick] [--maps 30] [--steps 3000] [--out DIR] [--model PATH]
-[--set KEY=VALUE ...] [--generators G ...] [--agents A ...] [--from F ...] [--ray [--address A]
+[--chooser PATH] [--set KEY=VALUE ...] [--generators G ...] [--agents A ...] [--from F ...] [--ray [--address A]
 [--workers N]]`` (also ``digslam benchmark agents ...``). ``--set`` gives every agent and generator an
 environment keyword (``--set grid_cell=0.078125``: the observer on a grid twice as fine; ``--set
 'noise={speed=0.0, yaw_rate=0.0}'``: exact odometry, the certified ceiling of a planner when the pose box
@@ -69,9 +70,12 @@ ENV_ID = "digslam/DigCoverage-v0"
 MODEL = Path(__file__).resolve().parents[1] / "agents" / "data" / "goals_attention.zip"
 #: The low-level PPO policy (continuous actions on the map), a comparison row (``ppo_lowlevel``).
 LOWLEVEL = Path(__file__).resolve().parents[1] / "agents" / "data" / "ppo_digcoverage.zip"
-#: The learned rows: ``ppo`` (``--model``), ``ppo_lowlevel`` (``--lowlevel``) and ``predictive_frontier`` (the
-#: frontier agent on the shipped map predictor's map, ``agents/data/map_predictor.pt``).
-LEARNED = ("ppo", "ppo_lowlevel", "predictive_frontier")
+#: The learned chooser of the predicted gains (a goal-level MaskablePPO), the ``predictive_chooser`` row.
+CHOOSER = Path(__file__).resolve().parents[1] / "agents" / "data" / "goals_predictive.zip"
+#: The learned rows: ``ppo`` (``--model``), ``ppo_lowlevel`` (``--lowlevel``), ``predictive_frontier`` (the
+#: frontier agent on the shipped map predictor's map, ``agents/data/map_predictor.pt``) and
+#: ``predictive_chooser`` (``--chooser``).
+LEARNED = ("ppo", "ppo_lowlevel", "predictive_frontier", "predictive_chooser")
 #: The diagnosis row that runs beside ``predictive_frontier``: the same planner on the true map.
 ORACLE = "oracle"
 
@@ -140,6 +144,8 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=3000, help="steps per episode (default 3000)")
     ap.add_argument("--quick", action="store_true", help="a smoke run: 3 maps, 300 steps")
     ap.add_argument("--model", type=Path, default=MODEL, help="the learned model of the ppo row (.zip)")
+    ap.add_argument("--chooser", type=Path, default=CHOOSER,
+                    help="the model of the predictive_chooser row (.zip; default the shipped one)")  # fmt: skip
     ap.add_argument("--lowlevel", type=Path, default=LOWLEVEL,
                     help="the model of the ppo_lowlevel row (.zip; default the shipped low-level PPO)")  # fmt: skip
     ap.add_argument(
@@ -191,6 +197,11 @@ def main() -> None:
         low = load_ppo(args.lowlevel)
     if low is not None:
         policies["ppo_lowlevel"], extra["ppo_lowlevel"] = low, {**model_kwargs(args.lowlevel), **common}
+    wanted = args.agents is None or "predictive_chooser" in args.agents
+    chooser = load_ppo(args.chooser) if wanted and loaded is None else None
+    if chooser is not None:
+        policies["predictive_chooser"] = chooser
+        extra["predictive_chooser"] = {**model_kwargs(args.chooser), **common}
     wanted = args.agents is None or "predictive_frontier" in args.agents
     if wanted and loaded is None:
         add_predictive(policies, extra, common, args.ray)

@@ -25,7 +25,7 @@ def agent_names() -> list[str]:
     the baselines."""
     from digslam.agents.baselines.registry import BASELINES
 
-    return ["best", "ppo", *BASELINES, "predictive_frontier"]
+    return ["best", "ppo", *BASELINES, "predictive_frontier", "predictive_chooser"]
 
 
 def model_env_kwargs(model: Path | None = None) -> dict[str, Any]:
@@ -48,7 +48,8 @@ def load_ppo(path: Path, env: Any) -> Any:
 def load_agent(name: str, env: Any, model: Path | None = None) -> Any:
     """A policy with SB3's ``predict``: ``"ppo"`` (a saved PPO model, default the shipped one; a goal-level
     model comes as a :class:`~digslam.agents.goals.GoalAgent`), ``"predictive_frontier"`` (on the map
-    predictor ``model``, default the shipped one) or a baseline name of
+    predictor ``model``, default the shipped one), ``"predictive_chooser"`` (the goal-level ``model`` that
+    reads the predicted gains, default :data:`~digslam.agents.learning.models.CHOOSER`) or a baseline name of
     :data:`digslam.agents.baselines.registry.BASELINES`.
 
     Raises:
@@ -56,6 +57,8 @@ def load_agent(name: str, env: Any, model: Path | None = None) -> Any:
     """
     if name == "ppo":
         return load_ppo(Path(model) if model is not None else models.PRETRAINED, env)
+    if name == "predictive_chooser":
+        return load_ppo(Path(model) if model is not None else models.CHOOSER, env)
     if name == "best":
         name = models.best_agent()[0]
     if name == "predictive_frontier":
@@ -89,11 +92,14 @@ def resolve_agent(name: str, env_id: str, model: Path | None) -> tuple[str, Any,
         best, why = models.best_agent()
         print(f"--agent best: {best}, {why}")
         name = best if best in agent_names() and best != "best" else "frontier"
-    if model is not None and name not in ("ppo", "predictive_frontier"):
-        raise UserError(f"--model: only with --agent ppo or predictive_frontier (got --agent {name})")
+    if model is not None and name not in ("ppo", "predictive_frontier", "predictive_chooser"):
+        raise UserError("--model: only with --agent ppo, predictive_frontier or predictive_chooser "
+                        f"(got --agent {name})")  # fmt: skip
     pretrained = models.PRETRAINED  # read at call time (tests point it elsewhere)
+    if name == "predictive_chooser" and model is None:
+        model = models.CHOOSER
     path = Path(model) if model is not None else pretrained
-    kwargs = model_env_kwargs(path) if name == "ppo" else {}
+    kwargs = model_env_kwargs(path) if name in ("ppo", "predictive_chooser") else {}
     env = make_env(env_id, kwargs, f"{path.with_suffix('.json')}" if kwargs else "--env")
     try:
         if name == "ppo" and model is None:

@@ -19,10 +19,12 @@ def agent_options(p: argparse.ArgumentParser, default: str) -> None:
     p.add_argument("--agent", default=default,
                    help="best (the best agent of the shipped leaderboard), ppo (the pretrained policy) or "
                         "a baseline: random, lawnmower, frontier, uncertainty_frontier, tour_frontier, "
-                        "distance_advantage, or predictive_frontier (the frontier agent on the shipped map "
-                        "predictor) (default %(default)s)")  # fmt: skip
-    p.add_argument("--model", default=None, help="saved PPO model (.zip), or map predictor (.pt) of "
-                   "predictive_frontier, instead of the shipped one")  # fmt: skip
+                        "distance_advantage, predictive_frontier (the frontier agent on the shipped map "
+                        "predictor) or predictive_chooser (the learned chooser of its gains) "
+                        "(default %(default)s)")  # fmt: skip
+    p.add_argument("--model", default=None, help="saved PPO model (.zip; a goal-level one for "
+                   "predictive_chooser), or map predictor (.pt) of predictive_frontier, instead of the "
+                   "shipped one")  # fmt: skip
     p.add_argument("--env", default=DEFAULT_ENV, help="environment id (default %(default)s)")
     p.add_argument("--seed", type=int, default=0, help="episode seed (default %(default)s)")
 
@@ -52,8 +54,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("evaluate", help="every agent on the same held-out maps: table and figure")
     p.add_argument("--agents", nargs="+", default=["ppo", "frontier"], help="agents (default %(default)s)")
-    p.add_argument("--model", default=None, help="saved PPO model (.zip), or map predictor (.pt) of "
-                   "predictive_frontier, instead of the shipped one")  # fmt: skip
+    p.add_argument("--model", default=None, help="saved PPO model (.zip; a goal-level one for "
+                   "predictive_chooser), or map predictor (.pt) of predictive_frontier, instead of the "
+                   "shipped one")  # fmt: skip
     p.add_argument("--env", default=DEFAULT_ENV, help="environment id (default %(default)s)")
     p.add_argument("--maps", type=int, default=5, help="held-out maps (default %(default)s)")
     p.add_argument("--steps", type=int, default=1000, help="steps per episode (default %(default)s)")

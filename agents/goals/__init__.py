@@ -6,7 +6,8 @@ Importing this package registers ``digslam/DigCoverageGoals-v0`` (room) and ``Di
 
 Lives here: :mod:`.driver` (``GoalDriver``: the frontier agent's loop towards a fixed goal, and the events
 that end a macro step), :mod:`.candidates` (the candidate goals and their features, from the observation
-only), :mod:`.env` (``GoalSelectionEnv``, the semi-MDP wrapper), :mod:`.agent` (``GoalAgent``: a goal-level
+only), :mod:`.extra` (more candidate features named by an entry point, such as the map predictor's
+gains), :mod:`.env` (``GoalSelectionEnv``, the semi-MDP wrapper), :mod:`.agent` (``GoalAgent``: a goal-level
 chooser, e.g. a trained ``MaskablePPO``, as a policy of the low-level env, step by step), :mod:`.policy`
 (``FirstCandidatePolicy``, ``RandomCandidatePolicy``) and :mod:`.registry` (the ids).
 
@@ -46,6 +47,9 @@ from .env import (
     MAX_EMPTY,
     GoalSelectionEnv,
 )
+from .extra import (
+    CandidateFeatures,
+)
 from .policy import (
     FirstCandidatePolicy,
     RandomCandidatePolicy,
@@ -60,6 +64,7 @@ register_goal_envs()
 
 __all__ = [
     "CLOSURE",
+    "CandidateFeatures",
     "Candidates",
     "ENTRY_POINT",
     "FEATURES",

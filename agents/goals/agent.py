@@ -37,6 +37,7 @@ from digslam.agents.baselines.policy import S_ELAPSED, Memory
 from digslam.agents.goals.candidates import Candidates
 from digslam.agents.goals.driver import KINDS, GoalDriver, driver_for
 from digslam.agents.goals.env import GoalSelectionEnv, decide, drive, ends, goal_space, start_goal
+from digslam.agents.goals.extra import n_extra
 
 _GOAL_PARAMS = inspect.signature(GoalSelectionEnv.__init__).parameters
 #: The keywords of :class:`~.env.GoalSelectionEnv` that are its own (the rest go to the base env), with their
@@ -102,6 +103,8 @@ class GoalAgent:
         max_steps: Low-level steps of an episode, which scales the ``elapsed`` global feature (the goal env's
             base env has ``horizon = max_steps``).
         include_map: Add the low-level ``"map"`` to the goal observation (a chooser trained with it).
+        candidate_features: Entry point of the extra candidate features the chooser was trained with
+            (:mod:`.extra`); None: none.
         deterministic: Passed to the chooser when the caller passes none.
         action_space, observation_space: The low-level env's (for symmetry with SB3).
     """
@@ -115,6 +118,7 @@ class GoalAgent:
         step_cap: int = 100,
         max_steps: int = 3000,
         include_map: bool = False,
+        candidate_features: str | None = None,
         deterministic: bool = True,
         action_space: Any = None,
         observation_space: Any = None,
@@ -130,6 +134,8 @@ class GoalAgent:
         self.chooser, self.driver = chooser, driver
         self.n, self.step_cap, self.max_steps = n_candidates, step_cap, max_steps
         self.include_map, self.deterministic = bool(include_map), bool(deterministic)
+        self.candidate_features = candidate_features
+        self._n_more = n_extra(candidate_features)
         self.action_space, self.observation_space = action_space, observation_space
         params = _params(chooser.predict)
         self._masks = "action_masks" in params or "**" in params
@@ -144,7 +150,8 @@ class GoalAgent:
 
         ``kw``: the goal env's keywords (:data:`GOAL_KWARGS`): ``n_candidates``, ``step_cap``,
         ``max_steps`` (default: the env's ``horizon``, else 3000), ``replan_every``, ``include_map``,
-        ``driver_kwargs``; those of :data:`REWARD_KWARGS` are ignored; and ``deterministic``.
+        ``candidate_features``, ``driver_kwargs``; those of :data:`REWARD_KWARGS` are ignored; and
+        ``deterministic``.
 
         Raises:
             ValueError: an unknown keyword, or ``env`` is a goal-selection env (give its base env).
@@ -159,8 +166,8 @@ class GoalAgent:
         driver = driver_for(env, replan_every=g["replan_every"], **dict(g["driver_kwargs"] or {}))
         return cls(chooser, driver, n_candidates=g["n_candidates"], step_cap=g["step_cap"],
                    max_steps=g["max_steps"], include_map=g["include_map"],
-                   deterministic=kw.get("deterministic", True), action_space=env.action_space,
-                   observation_space=env.observation_space)  # fmt: skip
+                   candidate_features=g["candidate_features"], deterministic=kw.get("deterministic", True),
+                   action_space=env.action_space, observation_space=env.observation_space)  # fmt: skip
 
     @property
     def goal_observation_space(self) -> Any:
@@ -168,7 +175,7 @@ class GoalAgent:
         map_space = self.observation_space["map"] if self.include_map and self.observation_space else None
         if self.include_map and map_space is None:
             raise ValueError("goal_observation_space: include_map needs the low-level observation_space")
-        return goal_space(self.n, map_space)
+        return goal_space(self.n, map_space, self._n_more)
 
     def reset(self) -> None:
         """Forget every environment's episode (and reset the chooser, if it has per-episode state)."""
@@ -220,7 +227,7 @@ class GoalAgent:
         while True:
             if not s.running:
                 s.candidates, goal_obs = decide(self.driver, obs, s.mem, self.n, s.t, self.max_steps,
-                                                self.include_map)  # fmt: skip
+                                                self.include_map, self.candidate_features)  # fmt: skip
                 a = self._choose(goal_obs, s.candidates, det)
                 kind, s.goal = start_goal(self.driver, s.mem, s.candidates, a)
                 s.kind, s.running, s.steps, s.decisions = KINDS[kind], True, 0, s.decisions + 1

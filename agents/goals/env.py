@@ -11,7 +11,8 @@ over, or ``step_cap`` low-level steps.
   (sb3-contrib's ``MaskablePPO`` / ``ActionMasker``); a masked action raises ``ValueError``. A random
   valid action: ``env.action_space.sample(mask=env.action_masks().astype(np.int8))``;
 * observation: ``{"candidates": Box(-1, 1, (n, F)), "mask": MultiBinary(n), "global": Box(-1, 1, (G,))}``
-  (+ ``"map"``, the base map, with ``include_map``): the features of :data:`.candidates.FEATURES` and
+  (+ ``"map"``, the base map, with ``include_map``): the features of :data:`.candidates.FEATURES` (then
+  those of the ``candidate_features`` entry point, :mod:`.extra`) and
   :data:`GLOBALS` (the base ``"state"``, the observer's own certified share ``state[9]`` among them, never
   ``info["certified_coverage"]`` or ``info["true_coverage"]``). A function of the base observations only;
 * reward: ``reward_scale`` x the base rewards summed over the macro step (certified area gained, m², minus
@@ -51,6 +52,7 @@ from gymnasium import spaces
 from digslam.agents.baselines.policy import Memory, parse
 from digslam.agents.goals.candidates import N_FEATURES, Candidates, candidates
 from digslam.agents.goals.driver import CLOSURE, FRONTIER, KINDS, TURN, GoalDriver, driver_for
+from digslam.agents.goals.extra import n_extra, with_extra
 
 #: Global features: the base ``"state"`` (11), then these (all in ``[-1, 1]``).
 GLOBALS = ("state",) * 11 + ("elapsed", "frontier_clusters", "closure_clusters", "dark_share",
@@ -74,6 +76,9 @@ class GoalSelectionEnv(gym.Wrapper):
         target_bonus: Reward when a frontier or closure goal is reached.
         reward_scale: Factor on the base rewards.
         include_map: Add the base ``"map"`` to the observation.
+        candidate_features: Entry point (``"module:name"``) of more features per candidate, appended to
+            :data:`.candidates.FEATURES` (:mod:`.extra`; the map predictor's gains:
+            ``"digslam.agents.prediction.features:PredictedGain"``); None: none.
         driver_kwargs: More :class:`~.driver.GoalDriver` arguments (frontier agent settings).
         render_mode: Passed to the base env when built here.
         **base_kwargs: DigCoverage keywords (``world``, ``map_size``, ``target``, ...).
@@ -92,6 +97,7 @@ class GoalSelectionEnv(gym.Wrapper):
         target_bonus: float = 0.0,
         reward_scale: float = 1.0,
         include_map: bool = False,
+        candidate_features: str | None = None,
         driver_kwargs: Mapping[str, Any] | None = None,
         render_mode: str | None = None,
         **base_kwargs: Any,
@@ -117,9 +123,12 @@ class GoalSelectionEnv(gym.Wrapper):
         self.step_cost, self.target_bonus = float(step_cost), float(target_bonus)
         self.reward_scale = float(reward_scale)
         self.include_map = bool(include_map)
+        self.candidate_features = candidate_features
+        n_more = n_extra(candidate_features)
         self.driver = driver_for(env, replan_every=replan_every, **dict(driver_kwargs or {}))
         self.action_space = spaces.Discrete(self.n)
-        self.observation_space = goal_space(self.n, env.observation_space["map"] if include_map else None)
+        self.observation_space = goal_space(self.n, env.observation_space["map"] if include_map else None,
+                                            n_more)  # fmt: skip
         self._base_obs: dict[str, np.ndarray] | None = None
         self._info: dict[str, Any] = {}
         self._cands: Candidates | None = None
@@ -226,15 +235,16 @@ class GoalSelectionEnv(gym.Wrapper):
         """Candidates and observation of the decision on the base observation ``obs``."""
         self._base_obs = obs
         self._cands, out = decide(self.driver, obs, self.mem, self.n, self._t, self.max_steps,
-                                  self.include_map)  # fmt: skip
+                                  self.include_map, self.candidate_features)  # fmt: skip
         return out
 
 
 # --- shared with :class:`~.agent.GoalAgent` (the same macro steps, one low-level step at a time) ---------
-def goal_space(n: int, map_space: spaces.Space | None = None) -> spaces.Dict:
-    """The observation space of ``n`` candidate slots (with the base ``map_space``: ``include_map``)."""
+def goal_space(n: int, map_space: spaces.Space | None = None, n_more: int = 0) -> spaces.Dict:
+    """The observation space of ``n`` candidate slots (with the base ``map_space``: ``include_map``; with
+    ``n_more`` extra features per candidate: ``candidate_features``)."""
     obs: dict[str, spaces.Space] = {
-        "candidates": spaces.Box(-1.0, 1.0, (n, N_FEATURES), np.float32),
+        "candidates": spaces.Box(-1.0, 1.0, (n, N_FEATURES + n_more), np.float32),
         "mask": spaces.MultiBinary(n),
         "global": spaces.Box(-1.0, 1.0, (len(GLOBALS),), np.float32),
     }
@@ -244,15 +254,17 @@ def goal_space(n: int, map_space: spaces.Space | None = None) -> spaces.Dict:
 
 
 def decide(driver: GoalDriver, obs: Mapping[str, np.ndarray], mem: Memory, n: int, t: int, max_steps: int,
-           include_map: bool = False) -> tuple[Candidates, dict[str, np.ndarray]]:  # fmt: skip
+           include_map: bool = False, candidate_features: str | None = None,
+           ) -> tuple[Candidates, dict[str, np.ndarray]]:  # fmt: skip
     """The candidates and the observation of a decision on the base observation ``obs``, ``t`` low-level
-    steps into an episode of ``max_steps`` (runs the driver's bookkeeping on it)."""
+    steps into an episode of ``max_steps`` (runs the driver's bookkeeping on it), with the extra features
+    of the ``candidate_features`` entry point (:mod:`.extra`)."""
     view = parse(obs["map"], obs["state"])
     c = candidates(driver, view, mem, n)
     nf = float(n)
     extra = [t / max_steps, c.n_frontier / nf, c.n_closure / nf, view.dark.mean(), view.penumbra.mean()]
     glob = np.concatenate([np.asarray(obs["state"], np.float32)[:11], np.asarray(extra, np.float32)])
-    out = {"candidates": c.features.copy(), "mask": c.mask.astype(np.int8),
+    out = {"candidates": with_extra(candidate_features, driver, view, c), "mask": c.mask.astype(np.int8),
            "global": np.clip(glob, -1.0, 1.0).astype(np.float32)}  # fmt: skip
     if include_map:
         out["map"] = np.array(obs["map"], copy=True)

@@ -40,6 +40,10 @@ DATA = Path(__file__).parents[1] / "data"
 #: The shipped learned agent (``--agent ppo``); the environment keywords it was trained with are in
 #: ``<model>.json``.
 PRETRAINED = DATA / "goals_attention.zip"
+#: The shipped learned chooser of the map predictor's gains (``--agent predictive_chooser``): a goal-level
+#: ``MaskablePPO`` whose candidate features include the predicted gain and its spread
+#: (``candidate_features``, :mod:`digslam.agents.prediction.features`).
+CHOOSER = DATA / "goals_predictive.zip"
 #: The shipped low-level PPO policy (continuous steering from the map), a comparison row of the benchmark.
 LOWLEVEL = DATA / "ppo_digcoverage.zip"
 #: The best agent of the last full leaderboard run (``benchmarks/bench_agents.py`` writes ``best.json`` to
@@ -232,7 +236,7 @@ def _goal_agent(model: Any, path: Path, env: Any, meta: dict[str, Any], opt: str
     return agent
 
 
-__all__ = ["DATA", "DEFAULT_ENV", "GOALS", "LEADERBOARD", "LOWLEVEL", "PRETRAINED", "TRAINING_ONLY",
-           "ModelError",
+__all__ = ["CHOOSER", "DATA", "DEFAULT_ENV", "GOALS", "LEADERBOARD", "LOWLEVEL", "PRETRAINED",
+           "TRAINING_ONLY", "ModelError",
            "as_policy", "best_agent", "goal_env_id", "leaderboard_record", "load_ppo", "model_env_kwargs",
            "model_meta"]  # fmt: skip

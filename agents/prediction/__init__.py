@@ -2,13 +2,14 @@
 
 The layout of every training level is free ground truth, so the net learns the world rather than a
 teacher's choices. Lives here: :mod:`.dataset` takes snapshots of the observer's map along episodes of the
-training
-levels with the true free share of every pixel as label; :mod:`.model` is the predictor (a small U-Net,
-the observation's map in, a free probability per pixel out); :mod:`.fit` trains it end to end
+training levels with the true free share of every pixel as label; :mod:`.model` is the predictor (a small
+U-Net, the observation's map in, a free probability per pixel out); :mod:`.fit` trains it end to end
 (``digslam train agents/configs/map_predictor.toml``); :mod:`.quality` scores it against two baselines on
 the pixels the input leaves open; :mod:`.agent` holds ``predictive_frontier`` (the frontier agent with the
 gain read on the predicted map) and the true-map diagnosis :class:`~.agent.TrueMap`, which
-:mod:`.oracle` runs.
+:mod:`.oracle` runs; :mod:`.features` gives the goal env's candidates the predicted gain and its spread
+as features (``candidate_features``), the inputs of the learned chooser ``predictive_chooser``
+(``digslam train agents/configs/goals_predictive.toml``).
 
 The prediction only ranks goals: every claim still comes from the observer, so a wrong prediction costs
 time, never soundness. Ground truth enters the training labels only, and the oracle diagnosis, which is

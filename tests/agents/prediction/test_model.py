@@ -55,3 +55,20 @@ def test_missing_or_damaged_files_say_so(tmp_path):
     (tmp_path / "bad.json").write_text("{}")
     with pytest.raises(ValueError, match="not a map predictor saved by digslam"):
         model.load(tmp_path / "bad.pt")
+
+
+def test_predicts_on_one_thread_and_restores_the_callers_count():
+    seen = []
+
+    class Probe(torch.nn.Module):
+        def forward(self, x):
+            seen.append(torch.get_num_threads())
+            return x[:, 0]
+
+    before = torch.get_num_threads()
+    torch.set_num_threads(2)
+    try:
+        model.Predictor(Probe()).logits(_maps(1, 36))
+        assert seen == [1] and torch.get_num_threads() == 2
+    finally:
+        torch.set_num_threads(before)
