@@ -39,8 +39,8 @@ def resolve(entry_point: str) -> CandidateFeatures:
     """The object of ``entry_point`` (``"package.module:name"``), built once per process.
 
     Raises:
-        ValueError: a malformed name, a module or attribute that is not there, or an object without
-            ``names`` and a call, each in one line.
+        ValueError: a malformed name, a module or attribute that is not there, an object that cannot be
+            built with no arguments, or one without ``names`` and a call, each in one line.
     """
     mod, sep, attr = str(entry_point).partition(":")
     if not (sep and mod and attr):
@@ -51,7 +51,12 @@ def resolve(entry_point: str) -> CandidateFeatures:
         raise ValueError(f"candidate_features: cannot load {entry_point!r} ({exc})") from None
     if not callable(obj):
         raise ValueError(f"candidate_features: {entry_point!r} is not callable (a class or a function)")
-    extra = obj()
+    try:
+        extra = obj()
+    except Exception as exc:  # noqa: BLE001 - whatever the named object raises, the user gets one line
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ValueError(f"candidate_features: {entry_point!r} could not be built with no arguments "
+                         f"({first})") from None  # fmt: skip
     names = getattr(extra, "names", None)
     if not callable(extra) or not names or not all(isinstance(n, str) for n in names):
         raise ValueError(f"candidate_features: {entry_point!r} builds no features (names and a call)")

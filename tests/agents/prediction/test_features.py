@@ -104,7 +104,9 @@ def test_deepcopy_shares_the_predictor():
 @pytest.mark.parametrize(
     ("name", "says"),
     [("no_colon", "expected 'package.module:name'"), ("digslam.nowhere:X", "cannot load"),
-     ("digslam.agents.prediction.features:ENTRY_POINT", "not callable")],
+     ("digslam.agents.prediction.features:ENTRY_POINT", "not callable"),
+     ("digslam.agents.prediction.model:Predictor", "could not be built with no arguments"),
+     ("digslam.agents.prediction.model:load_shipped", "builds no features")],
 )  # fmt: skip
 def test_bad_entry_points_say_so(name, says):
     with pytest.raises(ValueError, match=says):
