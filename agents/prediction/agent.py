@@ -73,11 +73,12 @@ class PredictiveFrontierAgent(FrontierAgent):
         uncertainty: Standard deviations of the free indicator subtracted from each pixel's weight.
         predict_every: Steps between predictions.
         n_rays: Rays cast from each candidate pixel.
-        predicted_weight: Weight (m) of the predicted gain. On 20 validation levels per generator with the
-            shipped predictor (seeds 1 000 000-1 000 019, 3000 steps, ``T_level`` speedup over the frontier
-            agent, geometric mean over the 80 levels) 160, 120, 80 and 50 scored 0.966, 1.009, 1.002 and
-            0.995, and on the 120 test maps 120 scored 0.994 against 1.003 for 160: the weight matters less
-            than the levels drawn, and every weight loses on the room (0.76-0.88 on validation).
+        predicted_weight: Weight (m) of the predicted gain. On 40 validation levels per generator with the
+            shipped predictor (seeds 1 000 000-1 000 039, 3000 steps, ``T_level`` speedup over the frontier
+            agent, geometric mean over the 160 levels) 160 alone scored 1.045 (room 0.82, rocks 1.11, caves
+            1.11, rooms 1.18); 160 beside ``gain_weight`` 20 1.057, 120 beside 40 1.022, 80 beside 40 with
+            ``uncertainty`` 1 1.014: within the levels' noise of each other, and every one loses on the room
+            (0.80-0.86), where the frontier agent's own gain is what wins.
         gain_weight: Weight (m) of the frontier agent's own dark-share gain, kept beside the predicted one;
             0 (the default) replaces it (with 40 beside 80: 1.031 on 6 validation levels per generator with
             the true map, where 160 alone scored 1.086).

@@ -93,33 +93,49 @@ def level_path(root: str | Path, generator: str, seed: int) -> Path:
 
 
 def generate(root: str | Path, generators: Sequence[str], seeds: Iterable[int], progress: bool = True,
-             **kw: Any) -> list[Path]:  # fmt: skip
+             workers: int = 1, **kw: Any) -> list[Path]:  # fmt: skip
     """Write :func:`generate_level` for every generator and seed under ``root`` (one file each), skipping
-    the files already there; the paths of all of them."""
+    the files already there; the paths of all of them. ``workers > 1`` writes the levels in that many
+    processes (spawned: each imports digslam afresh), with the same files as one process."""
     seeds = list(seeds)
     check_not_test("seeds", seeds)
+    if not (isinstance(workers, int) and workers >= 1):
+        raise ValueError(f"workers: must be an integer >= 1, got {workers!r}")
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
-    jobs = [(g, s) for s in seeds for g in generators]
+    paths = [level_path(root, g, s) for s in seeds for g in generators]
+    todo = [(str(level_path(root, g, s)), g, s, kw) for s in seeds for g in generators
+            if not _readable(level_path(root, g, s))]  # fmt: skip
     bar = None
     if progress:
         from tqdm.auto import tqdm
 
-        bar = tqdm(total=len(jobs), desc="snapshots", unit="level")
-    out = []
-    for g, s in jobs:
-        path = level_path(root, g, s)
-        if not _readable(path):
-            d = generate_level(g, s, **kw)
-            tmp = path.with_suffix(".tmp.npz")
-            np.savez_compressed(tmp, **d)
-            tmp.replace(path)  # a level is there whole or not at all (an interrupted run resumes)
-        out.append(path)
-        if bar is not None:
-            bar.update()
+        bar = tqdm(total=len(paths), initial=len(paths) - len(todo), desc="snapshots", unit="level")
+    if workers > 1 and len(todo) > 1:
+        import multiprocessing
+
+        with multiprocessing.get_context("spawn").Pool(min(workers, len(todo))) as pool:
+            for _ in pool.imap_unordered(_write_level, todo):
+                if bar is not None:
+                    bar.update()
+    else:
+        for job in todo:
+            _write_level(job)
+            if bar is not None:
+                bar.update()
     if bar is not None:
         bar.close()
-    return out
+    return paths
+
+
+def _write_level(job: tuple[str, str, int, dict[str, Any]]) -> str:
+    """Write one level's file atomically (there whole or not at all: an interrupted run resumes)."""
+    path, generator, seed, kw = job
+    d = generate_level(generator, seed, **kw)
+    tmp = Path(path).with_suffix(".tmp.npz")
+    np.savez_compressed(tmp, **d)
+    tmp.replace(path)
+    return path
 
 
 def _readable(path: Path) -> bool:

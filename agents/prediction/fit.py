@@ -4,12 +4,14 @@
 ``digslam train`` tells it from a PPO configuration) with ``key=value`` overrides. :func:`fit`:
 
 1. writes the snapshots of ``train_levels`` training-split and ``val_levels`` validation-split levels of
-   every generator under ``data_dir`` (:func:`.dataset.generate`: one file per level, resumable);
-2. fits :class:`~.model.MapUNet` by weighted binary cross-entropy against the free share of each pixel
-   (open pixels weigh 1, clear ones ``clear_weight``: they are known free), with random flips and quarter
-   turns, AdamW and a cosine learning rate, ``epochs`` passes or ``max_minutes`` of wall time, whichever
-   comes first; a checkpoint after every epoch (``out_dir/checkpoint.pt``; a rerun resumes from it),
-   TensorBoard scalars under ``out_dir/tb`` and a progress bar;
+   every generator under ``data_dir`` (:func:`.dataset.generate`: one file per level, resumable, in
+   ``workers`` processes);
+2. fits :class:`~.model.MapUNet` (a fresh one, or the weights of ``init``: fine-tuning) by weighted
+   binary cross-entropy against the free share of each pixel (open pixels weigh 1, clear ones
+   ``clear_weight``: they are known free), with random flips and quarter turns, AdamW and a cosine
+   learning rate, ``epochs`` passes or ``max_minutes`` of wall time, whichever comes first; a checkpoint
+   after every epoch (``out_dir/checkpoint.pt``; a rerun resumes from it, ``init`` or not), TensorBoard
+   scalars under ``out_dir/tb`` and a progress bar;
 3. scores the net on the validation snapshots (:mod:`.quality`) and writes ``out_dir/map_predictor.pt``
    with its sidecar: the command, the seed, the wall time, the data sizes and the validation figures.
 
@@ -51,7 +53,11 @@ class PredictorConfig(Config):
         generators: World generators of the levels.
         train_levels, val_levels: Levels per generator (the first of each split).
         episode_steps, snapshot_every: Low-level steps per episode and between snapshots.
+        workers: Processes that write the snapshots (one level each at a time).
         width: Channels of the net's first stage.
+        init: Weights to start from (a map predictor saved by :func:`.model.save` of the same ``width``, the
+            shipped one for example): the fit then fine-tunes them on this run's snapshots; empty for a
+            fresh net.
         epochs, batch_size, lr, weight_decay, clear_weight: The fit.
         max_minutes: Wall-time limit of the fit (the run stops after the epoch that passes it).
         seed: Seed of the net and of the batches.
@@ -68,7 +74,9 @@ class PredictorConfig(Config):
     val_levels: int = 24
     episode_steps: int = 2000
     snapshot_every: int = 60
+    workers: int = 1
     width: int = 8
+    init: str = ""
     epochs: int = 8
     batch_size: int = 64
     lr: float = 2e-3
@@ -85,9 +93,10 @@ class PredictorConfig(Config):
 
         check(self.kind == KIND, "kind", f'must be "{KIND}", got {self.kind!r}')
         check_generators(self.generators)
-        for name in ("train_levels", "val_levels", "episode_steps", "snapshot_every", "width", "epochs",
-                     "batch_size", "torch_threads"):  # fmt: skip
+        for name in ("train_levels", "val_levels", "episode_steps", "snapshot_every", "workers", "width",
+                     "epochs", "batch_size", "torch_threads"):  # fmt: skip
             check_int(name, getattr(self, name), 1)
+        check(isinstance(self.init, str), "init", f"must be a path (a string), got {self.init!r}")
         check_int("seed", self.seed, 0)
         for name in ("lr", "max_minutes"):
             check_finite_pos(name, getattr(self, name))
@@ -154,7 +163,12 @@ def _data(cfg: PredictorConfig) -> tuple[dict[str, np.ndarray], dict[str, np.nda
     from digslam.agents.prediction import dataset
     from digslam.envs.splits import seeds
 
-    kw = {"steps": cfg.episode_steps, "every": cfg.snapshot_every, "progress": cfg.progress}
+    kw = {
+        "steps": cfg.episode_steps,
+        "every": cfg.snapshot_every,
+        "progress": cfg.progress,
+        "workers": cfg.workers,
+    }
     root = Path(cfg.data_dir)
     train = dataset.generate(root / "train", cfg.generators, seeds("train", cfg.train_levels), **kw)
     val = dataset.generate(root / "validation", cfg.generators, seeds("validation", cfg.val_levels), **kw)
@@ -172,9 +186,18 @@ def fit(cfg: PredictorConfig, command: str | None = None) -> Path:
     device = _device(cfg.device)
     out = Path(cfg.out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    train, val = _data(cfg)
     torch.manual_seed(cfg.seed)
-    net = model.MapUNet(cfg.width).to(device)
+    net = model.MapUNet(cfg.width)
+    if cfg.init:  # read before the snapshots, so that a bad path fails at once
+        start_from = model.load(cfg.init).net
+        if start_from.width != cfg.width:
+            raise ValueError(
+                f"init: {cfg.init} has width {start_from.width}, the config says width "
+                f"{cfg.width}; set width={start_from.width} or start from a fresh net (init='')"
+            )
+        net.load_state_dict(start_from.state_dict())
+    net = net.to(device)
+    train, val = _data(cfg)
     opt = torch.optim.AdamW(net.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
     n = len(train["map"])
     per_epoch = max(n // cfg.batch_size, 1)

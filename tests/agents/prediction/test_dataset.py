@@ -42,3 +42,17 @@ def test_a_damaged_file_is_made_again(tmp_path):
 def test_test_levels_are_refused(tmp_path):
     with pytest.raises(ValueError, match="test split"):
         dataset.generate(tmp_path, ["room"], [2_000_000], progress=False)
+
+
+def test_workers_write_the_same_files_as_one_process(tmp_path):
+    kw = {"progress": False, "steps": 80, "every": 40}
+    one = dataset.generate(tmp_path / "one", ["room", "rocks"], [0, 1], **kw)
+    two = dataset.generate(tmp_path / "two", ["room", "rocks"], [0, 1], workers=2, **kw)
+    assert [p.name for p in two] == [p.name for p in one] == ["room_0.npz", "rocks_0.npz", "room_1.npz",
+                                                              "rocks_1.npz"]  # fmt: skip
+    for a, b in zip(one, two, strict=True):
+        with np.load(a) as x, np.load(b) as y:
+            for key in ("map", "state", "t", "free"):
+                np.testing.assert_array_equal(x[key], y[key])
+    with pytest.raises(ValueError, match="workers: must be an integer >= 1"):
+        dataset.generate(tmp_path, ["room"], [0], workers=0)

@@ -73,3 +73,43 @@ def test_the_shipped_predictor_continues_a_corridor():
     ahead = p[30:34, 32:40].mean()
     beside = np.concatenate([p[12:20, 32:40].ravel(), p[44:52, 32:40].ravel()]).mean()
     assert ahead > 0.5 and ahead > beside
+
+
+def _tiny_config(tmp_path: Path, **kw: object) -> PredictorConfig:
+    base = {"kind": "map_predictor", "generators": ["room"], "train_levels": 1, "val_levels": 1,
+            "episode_steps": 60, "snapshot_every": 30, "epochs": 1, "batch_size": 2, "progress": False,
+            "out_dir": str(tmp_path / "run"), "data_dir": str(tmp_path / "data"), "torch_threads": 1}  # fmt: skip
+    return PredictorConfig.from_dict({**base, **kw})
+
+
+def test_init_fine_tunes_the_given_weights(tmp_path):
+    """``init`` starts the fit from saved weights: at a vanishing learning rate the result is those weights,
+    not the fresh net the seed would draw."""
+    import torch
+
+    from digslam.agents.prediction.fit import fit
+    from digslam.agents.prediction.model import MapUNet, save
+
+    torch.manual_seed(123)
+    start = save(MapUNet(2), tmp_path / "start" / "p.pt", {"note": "start"})
+    fine = load(fit(_tiny_config(tmp_path, width=2, init=str(start), lr=1e-12))).net.state_dict()
+    first = load(start).net.state_dict()
+    fresh = load(fit(_tiny_config(tmp_path / "fresh", width=2, lr=1e-12))).net.state_dict()
+    key = next(k for k in first if k.endswith("weight"))
+    assert torch.allclose(fine[key], first[key], atol=1e-6)
+    assert not torch.allclose(fresh[key], first[key], atol=1e-3)
+    assert json.loads((tmp_path / "run" / "map_predictor.json").read_text())["config"]["init"] == str(start)
+
+
+def test_init_of_another_width_or_no_file_fails_in_one_line(tmp_path):
+    from digslam.agents.prediction.fit import fit
+    from digslam.agents.prediction.model import MapUNet, save
+
+    start = save(MapUNet(2), tmp_path / "start" / "p.pt", {})
+    with pytest.raises(ValueError, match=r"init: .* has width 2, the config says width 3"):
+        fit(_tiny_config(tmp_path, width=3, init=str(start)))
+    with pytest.raises(ValueError, match="no map predictor there"):
+        fit(_tiny_config(tmp_path, init=str(tmp_path / "none.pt")))
+    assert not (tmp_path / "data").exists()  # refused before any snapshot was taken
+    with pytest.raises(ValueError, match="init"):
+        _tiny_config(tmp_path, init=3)
