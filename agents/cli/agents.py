@@ -83,11 +83,13 @@ def resolve_agent(name: str, env_id: str, model: Path | None) -> tuple[str, Any,
     """``(name, policy, env_kwargs)``. ``"best"`` is the leaderboard's best agent
     (:func:`~.models.best_agent`; printed with the reason), or ``"ppo"`` when a ``model`` is given. A
     ``--model`` the user names must load (:class:`UserError` otherwise); without one, ``"ppo"`` falls back to
-    ``"frontier"`` (with a warning) when the shipped policy, torch or stable-baselines3 is unavailable."""
+    ``"frontier"`` (with a warning) when the shipped policy, torch or stable-baselines3 is unavailable, and so
+    does a leaderboard's ``"predictive_frontier"`` without torch."""
     if name not in agent_names():
         raise UserError(f"--agent {name!r}: unknown agent; known: {', '.join(agent_names())}")
     if name == "best" and model is not None:  # a model named on its own is the agent to run
         name = "ppo"
+    from_board = name == "best"
     if name == "best":  # the leaderboard's best agent, and the line that says so
         best, why = models.best_agent()
         print(f"--agent best: {best}, {why}")
@@ -102,6 +104,13 @@ def resolve_agent(name: str, env_id: str, model: Path | None) -> tuple[str, Any,
     kwargs = model_env_kwargs(path) if name in ("ppo", "predictive_chooser") else {}
     env = make_env(env_id, kwargs, f"{path.with_suffix('.json')}" if kwargs else "--env")
     try:
+        if from_board and name == "predictive_frontier":
+            try:
+                import torch  # noqa: F401
+            except ImportError:
+                warnings.warn('the leaderboard\'s best agent needs torch (pip install "digslam[train]"); '
+                              "using frontier", stacklevel=2)  # fmt: skip
+                return "frontier", load_agent("frontier", env), kwargs
         if name == "ppo" and model is None:
             try:
                 import sb3_contrib  # noqa: F401

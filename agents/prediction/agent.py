@@ -2,13 +2,20 @@
 
 The frontier agent (:class:`~digslam.agents.baselines.frontier.FrontierAgent`) ranks its candidate pixels by
 path length, tier and turn, less ``gain_weight`` times an expected gain; there the gain is the dark share
-around the pixel, blind to what lies in the dark. Here it is the free area a sensor would newly see from
-the pixel on the map that a *map source* predicts (:func:`.gain_jit.visible_gain`, MapEx's estimated
+around the pixel, blind to what lies in the dark. Here the gain is the free area a sensor would newly see
+from the pixel on the map that a *map source* predicts (:func:`.gain_jit.visible_gain`, MapEx's estimated
 visible area): the beams cross the predicted free probability ``p`` and count the dark and penumbra pixels,
 each weighted by ``p - uncertainty * sqrt(p (1 - p))`` (the prediction less ``uncertainty`` standard
 deviations of its Bernoulli free indicator), as a share of the square of side twice the sensor range (the
 frontier gain's own scale). A dead end (a frontier that faces a wall the predictor expects) then loses to a
 frontier that opens onto a room.
+
+The candidate chosen is the one of least **path per predicted gain** (``score="ratio"``, the default):
+``(c + path_offset) / (g + gain_floor)`` up to a constant, ``c`` the frontier agent's cost of the pixel
+(path length, tier penalty and turn) and ``g`` its predicted gain. A near frontier with little behind it
+still wins over a far one with a little more, and one that opens onto much new ground wins from farther
+away. The cost less a multiple of the gain (``score="difference"``) makes the gain dominate the path
+wherever the weight is large enough to matter, and the agent then criss-crosses an open room.
 
 A map source has ``free(image) -> (p, var)``, ``(m, m)`` float arrays from the observation's uint8 map:
 
@@ -73,29 +80,45 @@ class PredictiveFrontierAgent(FrontierAgent):
         uncertainty: Standard deviations of the free indicator subtracted from each pixel's weight.
         predict_every: Steps between predictions.
         n_rays: Rays cast from each candidate pixel.
-        predicted_weight: Weight (m) of the predicted gain. On 40 validation levels per generator with the
-            shipped predictor (seeds 1 000 000-1 000 039, 3000 steps, ``T_level`` speedup over the frontier
-            agent, geometric mean over the 160 levels) 160 alone scored 1.045 (room 0.82, rocks 1.11, caves
-            1.11, rooms 1.18); 160 beside ``gain_weight`` 20 1.057, 120 beside 40 1.022, 80 beside 40 with
-            ``uncertainty`` 1 1.014: within the levels' noise of each other, and every one loses on the room
-            (0.80-0.86), where the frontier agent's own gain is what wins.
-        gain_weight: Weight (m) of the frontier agent's own dark-share gain, kept beside the predicted one;
-            0 (the default) replaces it (with 40 beside 80: 1.031 on 6 validation levels per generator with
-            the true map, where 160 alone scored 1.086).
+        predicted_weight: Weight (m) of the predicted gain in the ``"difference"`` score; 0 turns the
+            prediction off in both scores (the frontier agent's costs).
+        gain_weight: Weight (m) of the frontier agent's own dark-share gain, kept in ``c`` beside the
+            predicted one; 0 (the default) replaces it.
         gain: ``"visible"`` (rays over the predicted map) or ``"area"`` (the predicted free share of the
-            unknown pixels in the sensor range's square, no visibility: 0.971 there).
-        count: The pixels that count as new: ``"unknown"`` (dark and penumbra) or ``"dark"`` only (0.952).
+            unknown pixels in the sensor range's square, no visibility).
+        count: The pixels that count as new: ``"unknown"`` (dark and penumbra) or ``"dark"`` only.
+        score: ``"ratio"`` (path per predicted gain) or ``"difference"`` (path less ``predicted_weight``
+            times the gain). On 40 validation levels per generator with the shipped predictor (seeds
+            1 000 000-1 000 039, 3000 steps, ``T_level`` speedup over the frontier agent, geometric mean
+            over the 160 levels) the ratio with the defaults below scored 1.163 (room 1.115, rocks 1.213,
+            caves 1.102, rooms 1.226); the difference at weight 160 scored 1.045 (room 0.819), and every
+            weighting of it beside ``gain_weight`` 20-40 lost on the room (0.80-0.86).
+        path_offset: Added to ``c`` in the ratio (m; 10 pixels of the default 64-pixel map): how much a
+            goal next to the robot still costs.
+        gain_floor: Added to ``g`` in the ratio (a share): a candidate with no predicted gain costs its
+            path times ``(gain_scale + gain_floor) / gain_floor``, not infinity.
+        gain_scale: The gain (a share) at which the ratio equals ``c + path_offset`` (in pixels), so that
+            the goal hysteresis (:func:`~digslam.agents.baselines.frontier.keep_bound`) keeps its meaning.
         **kw: :class:`FrontierAgent` arguments.
     """
 
     def __init__(self, action_space: Any, observation_space: Any = None, seed: int | None = None,
                  predictor: MapSource | None = None, uncertainty: float = 0.0, predict_every: int = 10,
                  n_rays: int = 32, predicted_weight: float = 160.0, gain_weight: float = 0.0,
-                 gain: str = "visible", count: str = "unknown", **kw: Any) -> None:  # fmt: skip
+                 gain: str = "visible", count: str = "unknown", score: str = "ratio",
+                 path_offset: float = 3.125, gain_floor: float = 0.01, gain_scale: float = 0.1,
+                 **kw: Any) -> None:  # fmt: skip
         if gain not in ("visible", "area") or count not in ("unknown", "dark"):
             raise ValueError(
                 f"gain, count: must be 'visible'/'area' and 'unknown'/'dark', got {gain!r}, {count!r}"
             )
+        if score not in ("ratio", "difference"):
+            raise ValueError(f"score: must be 'ratio' or 'difference', got {score!r}")
+        for name, v in (("path_offset", path_offset), ("gain_floor", gain_floor), ("gain_scale", gain_scale)):
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"{name}: must be finite and > 0, got {v!r}")
+        self.score, self.path_offset = score, float(path_offset)
+        self.gain_floor, self.gain_scale = float(gain_floor), float(gain_scale)
         self.gain_mode, self.count = gain, count
         self.predicted_weight = float(predicted_weight)
         if not (math.isfinite(uncertainty) and uncertainty >= 0):
@@ -114,16 +137,27 @@ class PredictiveFrontierAgent(FrontierAgent):
         super().__init__(action_space, observation_space, seed, gain_weight=gain_weight, **kw)
 
     def frontier_costs(self, view: View, mem: Memory, reach: np.ndarray, dist: np.ndarray) -> np.ndarray:
-        """The frontier agent's costs less ``predicted_weight`` times the predicted gain
-        (:meth:`predicted_gain`) over the pixel side."""
+        """The frontier agent's costs ``c`` (path length, tier, turn; in pixels) turned into the cost of the
+        predicted gain ``g`` (:meth:`predicted_gain`) of every candidate:
+
+        * ``score="ratio"``: path per gain, ``(max(c, 0) + path_offset) (gain_scale + gain_floor) / (g +
+          gain_floor)``: the path length per unit of expected new area, scaled so that a candidate of gain
+          ``gain_scale`` costs its path plus ``path_offset``;
+        * ``score="difference"``: ``c - predicted_weight g``, over the pixel side.
+
+        ``predicted_weight = 0`` leaves the frontier agent's costs as they are (no prediction)."""
         cost = super().frontier_costs(view, mem, reach, dist)
-        if self.predicted_weight > 0:
-            cost -= (
-                self.predicted_weight
-                * self.predicted_gain(view, mem, np.isfinite(cost))
-                / self.px(cost.shape[0])
-            )
-        return cost
+        if self.predicted_weight <= 0:
+            return cost
+        px = self.px(cost.shape[0])
+        cand = np.isfinite(cost)
+        gain = self.predicted_gain(view, mem, cand)
+        if self.score == "difference":
+            return cost - self.predicted_weight * gain / px
+        out = np.full(cost.shape, np.inf)
+        scale = (self.gain_scale + self.gain_floor) / (gain[cand] + self.gain_floor)
+        out[cand] = (np.maximum(cost[cand], 0.0) + self.path_offset / px) * scale
+        return out
 
     def prediction(self, view: View, mem: Memory) -> tuple[np.ndarray, np.ndarray]:
         """``(p, var)`` of the current map, recomputed every ``predict_every`` steps."""

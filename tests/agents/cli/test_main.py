@@ -144,3 +144,15 @@ def test_benchmark_runs_scripts_or_explains(monkeypatch, capsys) -> None:  # typ
     monkeypatch.setattr(commands, "benchmarks_dir", lambda: None)
     assert cli.main(["benchmark", "agents"]) == 2
     assert "source checkout" in capsys.readouterr().err
+
+
+def test_the_leaderboards_predictive_agent_falls_back_to_frontier_without_torch(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """``--agent best`` naming ``predictive_frontier`` on an install without torch: one warning and the
+    frontier agent, not a failure; named on its own it is an error of one line."""
+    monkeypatch.setattr(models, "best_agent", lambda path=None: ("predictive_frontier", "best on the board"))
+    monkeypatch.setitem(sys.modules, "torch", None)  # import torch raises ImportError
+    with pytest.warns(UserWarning, match="needs torch"):
+        name, policy, _ = cli.resolve_agent("best", cli.DEFAULT_ENV, None)
+    assert name == "frontier" and type(policy).__name__ == "FrontierAgent"
+    with pytest.raises(cli.UserError, match="predictive_frontier: the map predictor needs torch"):
+        cli.resolve_agent("predictive_frontier", cli.DEFAULT_ENV, None)

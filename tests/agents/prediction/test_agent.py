@@ -105,3 +105,59 @@ def test_the_oracle_reads_the_true_map_and_runs_as_a_suite_row():
     env.close()
     res = oracle_suite(n_maps=1, steps=40, split="validation", generators=["room"])
     assert res.agents == [ORACLE] and res.results["room"].curves[ORACLE].shape == (1, 41)
+
+
+class _Uniform:
+    """A map source that predicts every pixel free with probability ``p``."""
+
+    def __init__(self, p: float) -> None:
+        self.p = p
+
+    def free(self, image):
+        m = np.asarray(image).shape[-1]
+        return np.full((m, m), self.p), np.zeros((m, m))
+
+
+def _costs(agent, obs):
+    """The frontier costs and predictive costs of ``agent`` at its first plan on ``obs``."""
+    from digslam.agents.baselines import planning as pl
+    from digslam.agents.baselines.frontier import FrontierAgent
+    from digslam.agents.baselines.policy import Memory, parse
+
+    view = parse(obs["map"], obs["state"])
+    mem = Memory(view.clear.shape[0])
+    trav = agent.traversable(view)
+    weight = agent.weights(view, trav)
+    free = np.isfinite(weight)
+    dist, _ = pl.shortest_paths(free, view.cell, np.where(free, weight, 1.0))
+    reach = np.isfinite(dist) & view.clear
+    base = FrontierAgent.frontier_costs(agent, view, mem, reach, dist)
+    return (
+        base,
+        agent.frontier_costs(view, mem, reach, dist),
+        agent.predicted_gain(view, mem, np.isfinite(base)),
+    )
+
+
+def test_the_ratio_score_is_path_per_predicted_gain():
+    """``score="ratio"``: ``(max(c, 0) + offset) (scale + floor) / (g + floor)`` on the candidates, ``inf``
+    elsewhere; ``"difference"``: ``c - w g / px``. Both rank by the same predicted gain ``g``."""
+    env = gym.make("digslam/DigCoverage-v0", world="caves", fixed_world=False)
+    obs, _ = env.reset(seed=1_000_002)
+    for _ in range(20):
+        obs, *_ = env.step(np.array([0.5, 0.3], np.float32))
+    ratio = make_predictive(env, predictor=_Uniform(0.7))
+    base, cost, gain = _costs(ratio, obs)
+    cand = np.isfinite(base)
+    px = ratio.px(base.shape[0])
+    assert cand.any() and np.array_equal(np.isfinite(cost), cand) and gain[cand].max() > 0
+    want = (np.maximum(base[cand], 0) + 3.125 / px) * (0.1 + 0.01) / (gain[cand] + 0.01)
+    np.testing.assert_allclose(cost[cand], want)
+    diff = make_predictive(env, predictor=_Uniform(0.7), score="difference", predicted_weight=80.0)
+    base, cost, gain = _costs(diff, obs)
+    np.testing.assert_allclose(cost[cand], base[cand] - 80.0 * gain[cand] / px)
+    with pytest.raises(ValueError, match="score: must be 'ratio' or 'difference'"):
+        make_predictive(env, predictor=_Uniform(0.7), score="product")
+    with pytest.raises(ValueError, match="gain_floor: must be finite and > 0"):
+        make_predictive(env, predictor=_Uniform(0.7), gain_floor=0.0)
+    env.close()
