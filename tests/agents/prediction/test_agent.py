@@ -126,10 +126,8 @@ def _costs(agent, obs):
 
     view = parse(obs["map"], obs["state"])
     mem = Memory(view.clear.shape[0])
-    trav = agent.traversable(view)
-    weight = agent.weights(view, trav)
-    free = np.isfinite(weight)
-    dist, _ = pl.shortest_paths(free, view.cell, np.where(free, weight, 1.0))
+    free, weight = agent.planner_graph(view, mem, view.clear)  # the soft planner's graph
+    dist, _ = pl.shortest_paths(free, view.cell, weight)
     reach = np.isfinite(dist) & view.clear
     base = FrontierAgent.frontier_costs(agent, view, mem, reach, dist)
     return (
