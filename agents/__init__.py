@@ -17,19 +17,9 @@ import importlib
 from typing import Any
 
 from digslam.observer.cache import origin as _origin
-from digslam.observer.core import compat as _compat
 
 _origin.warn_if_shadowed(__name__)
 
-#: Modules that moved into the concept folders: old name -> new path (the old path warns, for one release).
-MOVED = {
-    "policy": "baselines.policy", "planning": "baselines.planning", "frontier": "baselines.frontier",
-    "train": "learning.train", "extractor": "learning.extractor", "sweep": "learning.sweep",
-    "sweep_config": "learning.sweep_config", "evaluate": "evaluation.evaluate",
-    "pictures": "evaluation.pictures",
-    "ray_eval": "evaluation.ray_eval", "warmup": "cli.warmup", "origin": "digslam.observer.cache.origin",
-}  # fmt: skip
-_compat.install_aliases(__name__, MOVED)
 
 #: Public names and the submodule that defines each.
 _LAZY = {

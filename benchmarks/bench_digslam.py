@@ -32,9 +32,9 @@ from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.missions import loop_mission
 from digslam.envs.splits import seeds
 from digslam.observer.online.smoother import dig_slam
+from digslam.observer.record.grid import Grid
+from digslam.observer.record.mission import MissionRecord
 from digslam.observer.slam.digslam import DigSlamConfig, thesis_dig_slam
-from digslam.observer.slam.grid import Grid
-from digslam.observer.slam.record import MissionRecord
 
 
 def thesis_scenario(duration: float, repeats: int) -> float:

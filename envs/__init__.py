@@ -32,22 +32,9 @@ from digslam.envs.sim.generators import (
 from digslam.envs.sim.sensors import SensorSuite
 from digslam.envs.sim.world import World
 from digslam.observer.cache import origin as _origin  # a shadowing source folder is reported in one line
-from digslam.observer.core import compat as _compat
 
 _origin.warn_if_shadowed(__name__)
 
-#: Modules that moved into the concept folders: old name -> new path (the old path warns, for one release).
-MOVED = {
-    "geometry": "sim.geometry", "geometry_jit": "sim.geometry_jit", "raster": "sim.raster",
-    "tracing": "sim.tracing", "generators": "sim.generators", "render": "sim.render",
-    "arc": "sim.arc_jit", "robot": "sim.robot", "robot_jit": "sim.robot_jit", "sensors": "sim.sensors",
-    "noise": "sim.noise", "noise_jit": "sim.noise_jit", "coverage": "explore.coverage",
-    "coverage_jit": "explore.coverage_jit", "missions": "sim.missions", "explore_env": "explore.env",
-    "episode": "explore.episode", "observer_config": "dig_coverage.config",
-    "observer_wrapper": "dig_coverage.wrapper", "observer_maps": "dig_coverage.maps_jit",
-    "monitor": "dig_coverage.monitor",
-}  # fmt: skip
-_compat.install_aliases(__name__, MOVED)
 
 MAX_EPISODE_STEPS = 1000
 

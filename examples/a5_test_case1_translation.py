@@ -54,9 +54,9 @@ from pathlib import Path
 import numpy as np
 from _common import parser, report, save_figure
 
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 from digslam.observer.thick.function import ThickFunction
 from digslam.observer.thick.paver import ThickPaving, thick_pave
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
 from digslam.observer.thick.sivia import thick_sivia
 
 V_LO, V_HI = [0.7, -0.02], [1.3, 0.02]

@@ -30,8 +30,8 @@ from pathlib import Path
 import numpy as np
 from _common import parser, save_figure
 
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 from digslam.observer.thick.function import ThickFunction
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
 from digslam.observer.thick.sivia import ThickInverse, thick_sivia
 from digslam.observer.thick.subset import thick_sivia_subset_supset
 

@@ -35,6 +35,7 @@ from digslam.envs.sim.missions import loop_mission
 from digslam.envs.sim.raster import FREE, OCCUPIED
 from digslam.envs.sim.sensors import SensorSuite
 from digslam.envs.sim.world import World
+from digslam.observer.record.grid import Grid
 from digslam.observer.slam.explicit_slam import (
     ExplicitSlamConfig,
     ExplicitSlamResult,
@@ -44,8 +45,7 @@ from digslam.observer.slam.explicit_slam import (
     explicit_slam,
     mission_tube,
 )
-from digslam.observer.slam.grid import Grid
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 
 CELL = 0.25  # pixel side of the shapes and cell side of the map (a dyadic number: exact lattice)
 LOOP = np.array([(0.0, 0.0), (4.0, -4.5), (7.0, 0.0), (4.0, 5.0), (-1.0, 6.5), (-6.0, 4.0), (-7.0, -2.0),

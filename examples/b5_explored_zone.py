@@ -24,10 +24,10 @@ from pathlib import Path
 import numpy as np
 from _common import parser, report, save_figure
 
+from digslam.observer.record.grid import Grid
 from digslam.observer.slam.explored import explored_disks_grid, explored_hypotheses
 from digslam.observer.slam.explored_sweep import explored_sectors_grid, explored_sweep_grid, sweep_gates
-from digslam.observer.slam.grid import Grid
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 
 FRAME = ((-12.0, -12.0), (12.0, 12.0))
 

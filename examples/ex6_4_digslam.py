@@ -20,8 +20,8 @@ from _common import parser, report, save_figure
 
 from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.missions import loop_mission
+from digslam.observer.record.grid import Grid
 from digslam.observer.slam.digslam import DigSlamResult, thesis_dig_slam
-from digslam.observer.slam.grid import Grid
 
 
 def run(duration: float = 1200.0, cell: float = 0.05, seed: int = 0, out: str | Path | None = None) -> dict:

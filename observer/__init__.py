@@ -12,7 +12,7 @@ from digslam.observer import cache
 
 cache.prepare()  # stale caches cleared, the kernel store first, the cold-start notice registered
 
-from digslam.observer.core import arith, boxes, compat, rounding, trig
+from digslam.observer.core import arith, boxes, rounding, trig
 from digslam.observer.core.interval import Box, Interval, IntervalArray, dot
 from digslam.observer.expr.expr import Expr, Function
 from digslam.observer.expr.ops import (
@@ -47,6 +47,7 @@ from digslam.observer.polar.sep import (
     complement_boxes,
     sep_landmark_fwdbwd,
 )
+from digslam.observer.record.grid import Grid
 from digslam.observer.sets.contractors import Ctc, CtcCompose, CtcFixPoint, CtcFwdBwd, CtcInter, CtcUnion
 from digslam.observer.sets.minkowski import SepMinkowskiDiff, SepMinkowskiSum, sep_negate
 from digslam.observer.sets.projection import SepOnDims, SepProj
@@ -90,7 +91,6 @@ from digslam.observer.slam.explored import (
     explored_union,
 )
 from digslam.observer.slam.explored_sweep import explored_sectors_grid, explored_sweep_grid, sweep_gates
-from digslam.observer.slam.grid import Grid
 from digslam.observer.slam.landmarks import (
     CtcLandmarks,
     IterationStats,
@@ -123,16 +123,13 @@ from digslam.observer.thick.carving import (
     param_hull,
     srac,
 )
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA, UNKNOWN
 from digslam.observer.thick.function import ThickFunction
 from digslam.observer.thick.interval import ThickIntervalArray, thin
 from digslam.observer.thick.inversion import SepFixedParam, thick_inverse_classical, thick_inverse_proj
 from digslam.observer.thick.ops import thick_image, thick_image_param, thick_minkowski_sum, thick_product
 from digslam.observer.thick.paver import ThickPaving, ThickTest, thick_pave
 from digslam.observer.thick.sep import (
-    CLEAR,
-    DARK,
-    PENUMBRA,
-    UNKNOWN,
     ThickSep,
     thick_classify_grid,
     thick_relaxed_intersection,
@@ -153,8 +150,6 @@ from digslam.observer.tube.tube import (
     heading_from_gyro,
     unicycle_velocity,
 )
-
-compat.install_aliases(__name__, compat.OBSERVER)  # the flat module paths of 0.1, for one release
 
 __all__ = [
     "arith", "boxes", "rounding", "trig",

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from digslam.observer.slam.grid import Grid
+from digslam.observer.record.grid import Grid
 
 
 def assert_free(mask: np.ndarray, world: object, grid: Grid, rng: np.random.Generator, n: int = 3000) -> None:

@@ -14,8 +14,8 @@ import math
 import numpy as np
 
 from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam
-from digslam.observer.slam.grid import Grid
-from digslam.observer.slam.record import MissionRecord
+from digslam.observer.record.grid import Grid
+from digslam.observer.record.mission import MissionRecord
 
 HALF = 4.0  # the room is [-HALF, HALF]²
 GRID = Grid((-5.0, -5.0), (5.0, 5.0), (80, 80))

@@ -21,7 +21,7 @@ import math
 import mpmath
 import numpy as np
 
-from digslam.observer.slam.record import MissionRecord
+from digslam.observer.record.mission import MissionRecord
 
 DT = 0.1
 OMEGA, V1, V2, PSI0 = 0.4, 1.0, 0.3, 0.3

@@ -9,7 +9,6 @@ from __future__ import annotations
 import ast
 import importlib
 import re
-import warnings
 from pathlib import Path
 
 import pytest
@@ -21,18 +20,19 @@ MODS = scan()
 ALLOWED: dict[str, set[str]] = {
     "observer.cache": set(),
     "observer.core": set(),
+    "observer.record": set(),
     "observer.expr": {"observer.core"},
     "observer.sets": {"observer.core", "observer.expr"},
     "observer.paving": {"observer.core", "observer.sets"},
     "observer.polar": {"observer.core", "observer.expr", "observer.sets"},
     "observer.thick": {"observer.core", "observer.expr", "observer.sets", "observer.paving"},
     "observer.tube": {"observer.core"},
-    "observer.slam": {"observer.core", "observer.expr", "observer.sets", "observer.paving", "observer.polar",
+    "observer.slam": {"observer.core", "observer.record", "observer.expr", "observer.sets", "observer.paving", "observer.polar",
                       "observer.thick", "observer.tube"},
-    "observer.online": {"observer.core", "observer.slam", "observer.thick", "observer.tube"},
-    "envs.sim": {"observer.core", "observer.slam", "envs"},
-    "envs.explore": {"observer.core", "observer.slam", "envs.sim", "envs"},
-    "envs.dig_coverage": {"observer.core", "observer.slam", "observer.thick", "observer.online", "envs.sim",
+    "observer.online": {"observer.core", "observer.record", "observer.slam", "observer.thick", "observer.tube"},
+    "envs.sim": {"observer.core", "observer.record", "envs"},
+    "envs.explore": {"observer.core", "observer.record", "envs.sim", "envs"},
+    "envs.dig_coverage": {"observer.core", "observer.record", "observer.slam", "observer.thick", "observer.online", "envs.sim",
                           "envs.explore", "envs"},
     "agents.baselines": {"observer.core", "envs"},
     "agents.learning": {"observer.core", "envs", "agents.baselines", "agents.evaluation", "agents.goals"},
@@ -129,17 +129,6 @@ def test_observer_needs_only_numpy_scipy_numba() -> None:
 # --- documented paths --------------------------------------------------------------------------------
 README = (REPO / "README.md").read_text()
 DOCUMENTED = sorted(set(re.findall(r"\bdigslam\.(?:observer|envs|agents)(?:\.[a-z_]+)+", README)))
-OLD_PATHS = [
-    "online",
-    "explored",
-    "thick_carving",
-    "landmarks",
-    "shape_slam",
-    "shapes",
-    "rounding",
-    "testing",
-    "jit",
-]
 
 
 @pytest.mark.parametrize("pkg", ["digslam.observer", "digslam.envs", "digslam.agents"])
@@ -155,38 +144,20 @@ def test_every_path_in_the_readme_imports(path: str) -> None:
         pytest.fail(f"{path} does not import")
 
 
-@pytest.mark.parametrize("old", OLD_PATHS)
-def test_the_old_documented_module_paths_still_work(old: str) -> None:
-    import digslam.observer as observer
+def test_no_alias_finder_is_installed() -> None:
+    """Old module paths end: no import finder of digslam answers a name with a module at another path."""
+    import sys
 
-    full = f"digslam.observer.{old}"
-    new = observer.compat.OBSERVER.get(old)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        mod = importlib.import_module(full)
-    if new is None:  # still a real path (a folder now): no warning
-        assert mod.__name__ == full
-        return
-    assert mod is importlib.import_module(f"digslam.observer.{new}")
-    assert any(issubclass(w.category, DeprecationWarning) and new in str(w.message) for w in caught) or (
-        full in __import__("sys").modules
-    )
+    import digslam.agents
+    import digslam.envs
+    import digslam.observer  # noqa: F401
 
-
-@pytest.mark.parametrize(
-    "pkg, table",
-    [("digslam.observer", "compat.OBSERVER"), ("digslam.envs", "MOVED"), ("digslam.agents", "MOVED")],
-)
-def test_every_moved_module_resolves_to_its_new_home(pkg: str, table: str) -> None:
-    base = importlib.import_module(pkg)
-    moved = base
-    for attr in table.split("."):
-        moved = getattr(moved, attr)
-    for old, new in moved.items():
-        target = new if new.startswith("digslam.") else f"{pkg}.{new}"
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", DeprecationWarning)
-            assert importlib.import_module(f"{pkg}.{old}") is importlib.import_module(target), old
+    finders = [type(f).__module__ + "." + type(f).__qualname__ for f in sys.meta_path]
+    assert not [f for f in finders if f.startswith("digslam")], finders
+    for pkg in ("digslam.observer", "digslam.envs", "digslam.agents"):
+        assert not hasattr(importlib.import_module(pkg), "MOVED"), pkg
+    with pytest.raises(ImportError):
+        importlib.import_module("digslam.observer.online_jit")  # a 0.1 path
 
 
 def test_every_folder_package_is_installed() -> None:

@@ -21,7 +21,7 @@ def cmd_record(args: argparse.Namespace) -> int:
     import numpy as np
 
     from digslam.envs.explore.episode import Episode, GroundTruth
-    from digslam.observer.slam.record import MissionRecord
+    from digslam.observer.record.mission import MissionRecord
 
     check_env_id(args.env, "record")
     out = Path(args.out)
@@ -122,8 +122,8 @@ def cmd_replay(args: argparse.Namespace) -> int:
     print(f"{args.file}: {len(ep.actions)} steps, seed {ep.seed}; replay identical: {ok}")
     if args.digslam:
         from digslam.observer.online.smoother import dig_slam
+        from digslam.observer.record.grid import Grid
         from digslam.observer.slam.digslam import DigSlamConfig
-        from digslam.observer.slam.grid import Grid
 
         s = float(ep.config.world_size)
         grid = Grid((-s, -s), (s, s), (args.grid, args.grid))

@@ -21,7 +21,7 @@ import numpy as np
 
 from digslam.agents.evaluation import overlays as ov
 from digslam.envs.dig_coverage.env import RGB
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 
 MAP_SIZE = 512
 #: The panel: the read-out and legend column (``LEGEND_WIDTH`` px), then the inset's column.

@@ -38,7 +38,7 @@ from digslam.envs.dig_coverage.config import DigCoverageConfig
 from digslam.envs.dig_coverage.wrapper import GuaranteedObserver
 from digslam.envs.explore.env import ExploreEnv
 from digslam.envs.sim.raster import FREE, rasterize
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 
 #: Colours of the sets as RGB (Okabe-Ito, as ``digslam.agents.evaluation.pictures.PALETTE``).
 RGB = {

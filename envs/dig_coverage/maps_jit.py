@@ -40,7 +40,7 @@ import numpy as np
 
 from digslam.observer.core.grid_jit import window
 from digslam.observer.core.scalar_jit import njit
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 
 _CLEAR, _PENUMBRA, _DARK = int(CLEAR), int(PENUMBRA), int(DARK)
 

@@ -16,7 +16,7 @@ record and truth:
 Once the filter reports an inconsistency its claims are withdrawn, so nothing more is checked.
 
 >>> from digslam.envs.sim.world import World
->>> from digslam.observer.slam.grid import Grid
+>>> from digslam.observer.record.grid import Grid
 >>> sq = np.array([(-2.0, -2.0), (2.0, -2.0), (2.0, 2.0), (-2.0, 2.0)])
 >>> m = GuaranteeMonitor(World((-2, -2, 2, 2), [sq]), Grid((-2.0, -2.0), (2.0, 2.0), (4, 4)))
 >>> mask = np.zeros((4, 4), bool); mask[1, 1] = True
@@ -32,8 +32,8 @@ import numpy as np
 
 from digslam.envs.sim import geometry as geo
 from digslam.envs.sim.world import World
-from digslam.observer.slam.grid import Grid
-from digslam.observer.thick.sep import DARK
+from digslam.observer.record.grid import Grid
+from digslam.observer.thick.cells import DARK
 
 #: Sample points drawn per sensor and step for claim 3.
 SENSED_SAMPLES = 32

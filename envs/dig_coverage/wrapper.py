@@ -60,7 +60,7 @@ sensed, no dark cell was) are proved under a premise on the records; the filter 
 (``noise.max_outliers``) and an observer with ``q = 1``.
 
 Records go to the filter as they come: record ``k``'s odometry bounds the step that ends at ``t_k``, the
-data contract of :mod:`digslam.observer.slam.record` that both the env and the filter follow.
+data contract of :mod:`digslam.observer.record.mission` that both the env and the filter follow.
 
 >>> from digslam.envs.explore.env import ExploreEnv
 >>> env = GuaranteedObserver(ExploreEnv(), map_size=36)
@@ -96,8 +96,8 @@ from digslam.envs.explore.coverage import Coverage
 from digslam.envs.sim.raster import FREE, rasterize
 from digslam.envs.sim.world import World
 from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam
-from digslam.observer.slam.grid import Grid
-from digslam.observer.thick.sep import PENUMBRA
+from digslam.observer.record.grid import Grid
+from digslam.observer.thick.cells import PENUMBRA
 
 N_STATE = 11
 

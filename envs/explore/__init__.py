@@ -4,7 +4,7 @@ Lives here: :mod:`.env` (``ExploreEnv``), :mod:`.coverage` and :mod:`.coverage_j
 coverage: which cells the sensors truly swept), :mod:`.truth` (``GroundTruth``) and :mod:`.episode`
 (``Episode``, recording and replaying an episode).
 
-May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.slam.record`, :mod:`digslam.envs.sim`,
+May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.record.mission`, :mod:`digslam.envs.sim`,
 :mod:`digslam.envs.config`; gymnasium, numpy.
 """
 

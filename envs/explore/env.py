@@ -5,7 +5,7 @@ Action: normalised ``(v, omega)`` in ``[-1, 1]^2``: the commanded body-frame spe
 ``odometry (3, 2)`` (intervals of the forward speed, the leftward velocity and the yaw rate over the step
 just ended) and ``heading (2,)`` (compass interval, shifted by a multiple of 2 pi into about ``[-pi, pi]``).
 Reward: the newly and truly sensed free area (m^2). ``info`` holds the
-:class:`~digslam.observer.slam.record.MissionRecord` under ``"record"`` and the
+:class:`~digslam.observer.record.mission.MissionRecord` under ``"record"`` and the
 :class:`~digslam.envs.explore.episode.GroundTruth` under ``"truth"``.
 
 Record convention (record ``j`` is the one returned at time ``t_j``; ``j = 0`` by ``reset``):
@@ -20,18 +20,17 @@ Record convention (record ``j`` is the one returned at time ``t_j``; ``j = 0`` b
   the body frame at ``t_{j-1}``: ``R(-psi_{j-1}) (x_j - x_{j-1}) / (t_j - t_{j-1})``, tight when the
   velocity changes within the step; the unicycle leaves it unmeasured (``[-inf, inf]``).
 
-This is the data contract of :mod:`digslam.observer.slam.record`, which the observers (offline ``dig_slam``,
-the online filter of :mod:`.observer_wrapper`) read as it is. Every bound contains the exact truth,
-floating point included. Under pymunk dynamics (``dynamics="pymunk"``, the default) the truth is the
-piecewise-linear path through the substep states pymunk produced (``truth.states``, ``truth.taus``; exact
-by definition, ``pose_error = 0``) and the odometry hulls are rigorous bounds of its body-frame velocity and
-yaw rate (:mod:`digslam.envs.sim.dynamics_jit`); under the unicycle it is the chain of exact arcs of
-:mod:`digslam.envs.sim.arc_jit` (``truth.pieces``; the stored heading is exact, the stored position within
-the proved ``truth.pose_error``), and the odometry hulls are the pieces' exact speeds and outward-rounded
-yaw rates. Either way the robot's disc never overlaps an obstacle, and the ranges are rigorous bounds around
-the true pose (:meth:`~digslam.envs.sim.sensors.SensorSuite.range_bounds`). Each step lasts exactly the time
-between its two records.
-"""
+This is the data contract of :mod:`digslam.observer.record.mission`, which the observers (offline
+``dig_slam``, the online filter of :mod:`digslam.envs.dig_coverage.wrapper`) read as it is. Every bound
+contains the exact truth, floating point included. Under pymunk dynamics (``dynamics="pymunk"``, the default)
+the truth is the piecewise-linear path through the substep states pymunk produced (``truth.states``,
+``truth.taus``; exact by definition, ``pose_error = 0``) and the odometry hulls are rigorous bounds of its
+body-frame velocity and yaw rate (:mod:`digslam.envs.sim.dynamics_jit`); under the unicycle it is the chain of
+exact arcs of :mod:`digslam.envs.sim.arc_jit` (``truth.pieces``; the stored heading is exact, the stored
+position within the proved ``truth.pose_error``), and the odometry hulls are the pieces' exact speeds and
+outward-rounded yaw rates. Either way the robot's disc never overlaps an obstacle, and the ranges are rigorous
+bounds around the true pose (:meth:`~digslam.envs.sim.sensors.SensorSuite.range_bounds`). Each step lasts
+exactly the time between its two records."""
 
 from __future__ import annotations
 
@@ -54,7 +53,7 @@ from digslam.envs.sim.noise_jit import obs_kernel
 from digslam.envs.sim.robot import RobotSim
 from digslam.envs.sim.sensors import SensorSuite, record_step
 from digslam.envs.sim.world import World
-from digslam.observer.slam.record import MissionRecord
+from digslam.observer.record.mission import MissionRecord
 
 #: The largest ``|a_i|`` of an action (normalised ``v``, ``omega``) accepted, then clipped to ``[-1, 1]``.
 _ACTION_TOL = 1.0 + 1e-6

@@ -12,7 +12,7 @@ import numpy as np
 from digslam.envs.config import ExploreConfig
 from digslam.envs.explore.env import ExploreEnv
 from digslam.envs.explore.truth import GroundTruth
-from digslam.observer.slam.record import MissionRecord
+from digslam.observer.record.mission import MissionRecord
 
 
 @dataclass(eq=False)

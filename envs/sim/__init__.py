@@ -10,7 +10,7 @@ and sector distances), :mod:`.arc_jit` (the exact arc of one piece of motion and
 :mod:`.noise_jit` (bounded noise, outliers), :mod:`.missions` (the thesis's missions as records) and
 :mod:`.render` (pictures).
 
-May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.slam.record`, :mod:`digslam.envs.config`;
+May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.record.mission`, :mod:`digslam.envs.config`;
 numpy, scipy, pymunk, pygame (on use). No gymnasium.
 """
 

@@ -3,7 +3,7 @@
 The robot follows a closed loop of waypoints with a pure-pursuit controller. Between two samples its
 speed and yaw rate are constant over each slice, so the motion over ``[t_k, t_{k+1}]`` is an exact arc and
 its heading moves linearly from ``ψ_k`` to ``ψ_{k+1}``. The records follow the data contract of
-:mod:`digslam.observer.slam.record`, like the environments':
+:mod:`digslam.observer.record.mission`, like the environments':
 
 * ``speed[k]`` and ``yaw_rate[k]`` bound the true values over the slice ``[t_{k-1}, t_k]`` that ends at
   ``t_k`` (record 0: the robot at rest);
@@ -34,7 +34,7 @@ from digslam.envs.sim.arc_jit import arc_bounded, exact_duration, yaw_rate_bound
 from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.sensors import SensorSuite, measure_step
 from digslam.envs.sim.world import World
-from digslam.observer.slam.record import MissionRecord
+from digslam.observer.record.mission import MissionRecord
 
 #: A loop of waypoints inside the thesis room of Fig. 6.10 (at least 1.3 m from every wall).
 THESIS_LOOP = np.array(

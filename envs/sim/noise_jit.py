@@ -130,7 +130,7 @@ def record_kernel(r_b: np.ndarray, hulls: np.ndarray, heading: float, measured: 
     touches a bound). A reading is ``no_echo`` (``[r_max, inf]``) only when the lower bound exceeds ``r_max``;
     one whose upper bound is not finite reads ``[min(lo, r_max), inf]``. Every finite bound is widened by the
     model's ``tol``. Returns the first row whose interval has a NaN or ``lo > hi`` (the checks of
-    :class:`~digslam.observer.slam.record.MissionRecord`), -1 if none.
+    :class:`~digslam.observer.record.mission.MissionRecord`), -1 if none.
     """
     model, bias, b_speed, b_yaw, b_heading, b_range, tol = (int(noise[0]), noise[1], noise[2], noise[3],
                                                             noise[4], noise[5], noise[6])  # fmt: skip

@@ -4,7 +4,7 @@ Both dynamics share one interface (:class:`RobotSim`): :meth:`~RobotSim.step` ad
 behind rigorous hulls of the true forward velocity (:attr:`~RobotSim.speed_hull`), leftward velocity
 (:attr:`~RobotSim.lateral_hull`) and yaw rate (:attr:`~RobotSim.yaw_hull`) over the whole step, the true
 pose and a proved bound on its position error (:attr:`~RobotSim.pose_error`). Each is the data contract of
-the guaranteed observer (:mod:`digslam.observer.slam.record`): ``x' = R(psi) v`` with ``v = (v_1, v_2)``
+the guaranteed observer (:mod:`digslam.observer.record.mission`): ``x' = R(psi) v`` with ``v = (v_1, v_2)``
 inside the hulls at every instant.
 
 **pymunk** (``dynamics="pymunk"``, the default). The robot is a pymunk body (a disc of mass 1 and the moment

@@ -27,7 +27,7 @@ from digslam.envs.sim import geometry_jit as gjit
 from digslam.envs.sim.noise import outliers
 from digslam.envs.sim.noise_jit import MEASURE_LATERAL, MEASURE_MEAN, MODEL_CODES, RecordModel, record_kernel
 from digslam.envs.sim.world import World
-from digslam.observer.slam.record import MissionRecord
+from digslam.observer.record.mission import MissionRecord
 
 Hull = float | tuple[float, float]
 _ROWS = ("speed", "yaw_rate", "heading")

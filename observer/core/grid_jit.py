@@ -2,7 +2,7 @@
 
 A grid's columns are bounded by the increasing ``xs`` (``nx + 1`` values) and its rows, top to bottom, by the
 decreasing ``ys``; the kernels take ``nys = -ys`` (increasing) so that rows and columns are found the same
-way. :func:`window` is :meth:`.slam.grid.Grid.window` for one box, in machine code: two ``np.searchsorted``
+way. :func:`window` is :meth:`.record.grid.Grid.window` for one box, in machine code: two ``np.searchsorted``
 per axis, every comparison exact (nothing is rounded).
 
 >>> xs = np.array([0.0, 1.0, 2.0, 3.0]); nys = -np.array([3.0, 2.0, 1.0, 0.0])

@@ -27,7 +27,7 @@ A slice starts at a quarter of its side and halves while it may hold a feasible 
 the rest of one, that fails means that the data contradict their bounds: the empty box is returned.
 
 >>> from digslam.observer.online.window import grid_frame
->>> from digslam.observer.slam.grid import Grid
+>>> from digslam.observer.record.grid import Grid
 >>> g = grid_frame(Grid((0.0, 0.0), (4.0, 4.0), (40, 40)))
 >>> free = np.ones((40, 40), bool); free[:, 30:] = False        # a wall from x = 3 on, dug up to it
 >>> ranges = np.array([[0.99, 1.01], [np.inf, np.inf]])          # the cone along +x sees it at 1 m

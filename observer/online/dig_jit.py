@@ -27,7 +27,7 @@ one pose box each) and :class:`StepRecord` (one step's record, read by the pose 
 the online folder's kernels share these types.
 
 >>> from digslam.observer.online.window import grid_frame
->>> from digslam.observer.slam.grid import Grid
+>>> from digslam.observer.record.grid import Grid
 >>> g = Grid((-2.0, -2.0), (2.0, 2.0), (8, 8))
 >>> free, sure = np.zeros(g.shape, bool), np.zeros(g.shape, bool)
 >>> dig_cells(free, sure, grid_frame(g), PoseBox(0.0, 0.0, 0.0, 0.0, 0.0, 0.0), 0.0, np.pi, 1.2, True)
@@ -86,7 +86,7 @@ class GridFrame(NamedTuple):
     """The online filter's grid as its kernels read it (:func:`.window.grid_frame` builds it once per grid).
 
     The frame is ``[xs[0], xs[-1]] × [ys[-1], ys[0]]`` and the cell size :func:`cell_size`, both exactly
-    those of the :class:`~digslam.observer.slam.grid.Grid` (whose bounds are a ``linspace`` of its frame):
+    those of the :class:`~digslam.observer.record.grid.Grid` (whose bounds are a ``linspace`` of its frame):
     they are not stored, so that the tuple stays small (each field costs at every call from Python).
 
     Attributes:
@@ -185,7 +185,7 @@ NO_MEAN.flags.writeable = False
 
 class StepRecord(NamedTuple):
     """One single-step record as the filter's kernels read it: the fields of a single-step
-    :class:`~digslam.observer.slam.record.MissionRecord` and the duration of the step that ends at it.
+    :class:`~digslam.observer.record.mission.MissionRecord` and the duration of the step that ends at it.
 
     Attributes:
         dt: ``t_k - t_{k-1}``, the duration of the step (0 for the first record of an episode).

@@ -18,7 +18,7 @@ out means marked: a doubt never makes a cell dark.
 The readings come as a :class:`.dig_jit.StepRecord` (only its readings are read here).
 
 >>> from digslam.observer.online.window import grid_frame
->>> from digslam.observer.slam.grid import Grid
+>>> from digslam.observer.record.grid import Grid
 >>> g = Grid((-2.0, -2.0), (2.0, 2.0), (8, 8))
 >>> maybe = np.zeros(g.shape, bool)
 >>> mark_cells(maybe, grid_frame(g), PoseBox(0.0, 0.0, 0.0, 0.0, 0.0, 0.0), 0.0, np.pi / 8, 1.2)

@@ -7,7 +7,7 @@ Each :meth:`OnlineDigSlam.update` takes the next single-step record and
    ``v = (v_1, v_2)`` = (``speed``, ``lateral``) (``x' = R(ψ) v``, Eq. 3.59, 6.12, B.20; a unicycle record,
    ``lateral = [0, 0]``, gives Eq. 6.23's step to the bit; record ``k``'s velocity and yaw rate bound the
    truth over the slice ``[t_{k-1}, t_k]`` that ends at it: the data contract of
-   :mod:`digslam.observer.slam.record`); compiled scalar outward rounding (:func:`.pose_jit.predict`,
+   :mod:`digslam.observer.record.mission`); compiled scalar outward rounding (:func:`.pose_jit.predict`,
    :func:`.pose_jit.rotate`), each correctly rounded operation stepped one ulp outward, ``cos``/``sin``
    widened by more than :data:`~.rounding.LIBM_ULPS`;
 2. contracts the box with the impacts ``dist(x_k, comp M⁻) <= y⁺`` (Eq. 6.22) on a window
@@ -52,7 +52,7 @@ So up to ``q`` bad readings per step make no false claim at all. With more, the 
 ``q = 0`` with bad data: an empty box is still reported (the filter stops and withdraws its claims), but
 claims made before that may be false. ``q = 0`` runs exactly the former kernels (bit for bit, same speed).
 
->>> from digslam.observer.slam.record import MissionRecord
+>>> from digslam.observer.record.mission import MissionRecord
 >>> def step(k):
 ...     return MissionRecord(t=0.1 * k, speed=[0.99, 1.01], yaw_rate=[-0.01, 0.01], heading=[-1e-3, 1e-3],
 ...         alpha=[0.0], gamma=[np.pi], r_max=[5.0], range=[[1.99 - 0.1 * k, 2.01 - 0.1 * k]],
@@ -81,9 +81,9 @@ from digslam.observer.online.history import StepHistory
 from digslam.observer.online.mark_jit import dig_and_mark_q
 from digslam.observer.online.step_jit import filter_step_flat
 from digslam.observer.online.window import WindowDigMap
-from digslam.observer.slam.grid import Grid
-from digslam.observer.slam.record import MissionRecord
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.record.grid import Grid
+from digslam.observer.record.mission import MissionRecord
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 
 __all__ = ["OnlineConfig", "OnlineDigSlam"]
 

@@ -110,7 +110,7 @@ def mean_displacement(p_lo: float, p_hi: float, dtl: float, dth: float, mv: np.n
                       ) -> tuple[float, float, float, float]:  # fmt: skip
     """The step's displacement ``(d_x⁻, d_y⁻, d_x⁺, d_y⁺)`` from the odometry increment: the mean velocity
     ``[v̄] = mv (2, 2)`` over the step in the body frame at its start, ``v̄ = (1/dt) ∫ R(ψ(t) - ψ_{k-1}) v dt``
-    (a DVL integrated with the gyro's relative rotation; :mod:`digslam.observer.slam.record`). Since
+    (a DVL integrated with the gyro's relative rotation; :mod:`digslam.observer.record.mission`). Since
     ``x_k - x_{k-1} = ∫ R(ψ) v dt = R(ψ_{k-1}) dt v̄``, it lies in ``[dt]·R([ψ_{k-1}])·[v̄]`` with
     ``[ψ_{k-1}] = [p_lo, p_hi]`` and ``[dtl, dth] ∋ dt`` (:func:`rotate`, outward rounded)."""
     cl, ch, sl, sh = cos_sin(p_lo, p_hi)

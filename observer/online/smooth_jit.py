@@ -35,7 +35,7 @@ from digslam.observer.online.dig_jit import CellSets, GridFrame, PoseBox, StepRe
 from digslam.observer.online.mark_jit import dig_and_mark_q
 from digslam.observer.online.pose_jit import contract, impact_bound_q
 from digslam.observer.online.step_jit import CONE_MIN_WIDTH, filter_step_q
-from digslam.observer.slam.record import MissionRecord
+from digslam.observer.record.mission import MissionRecord
 
 __all__ = [
     "RecordArrays",
@@ -53,7 +53,7 @@ __all__ = [
 class RecordArrays(NamedTuple):
     """A stacked record of ``T + 1`` steps as the kernels read it (C-contiguous float64, ``no_echo`` bool):
     the fields of :class:`.dig_jit.StepRecord` with a leading time axis, ``t`` (``(T + 1,)``) in place of
-    ``dt`` (the same fields as :class:`~digslam.observer.slam.record.MissionRecord`, ``ranges`` for its
+    ``dt`` (the same fields as :class:`~digslam.observer.record.mission.MissionRecord`, ``ranges`` for its
     ``range``)."""
 
     t: np.ndarray

@@ -34,12 +34,12 @@ box, one cone contraction per box wider than :data:`.step_jit.CONE_MIN_WIDTH` an
 that shrank; 3000 steps of the coverage environment take about 0.3–1 s, and the §6.4.2 loop (12,001
 samples) a few seconds (``benchmarks/bench_digslam.py``).
 
-The data contract is :mod:`digslam.observer.slam.record`'s: ``speed[k]``, ``lateral[k]`` and
+The data contract is :mod:`digslam.observer.record.mission`'s: ``speed[k]``, ``lateral[k]`` and
 ``yaw_rate[k]`` bound the truth over the slice ``[t_{k-1}, t_k]`` that ends at ``t_k``; ``heading[k]`` bounds
 the heading at ``t_k``; ``range[k]`` bounds the ranges from the pose at ``t_k``; ``mean_velocity[k]`` bounds
 the velocity averaged over the slice in the body frame at its start.
 
->>> from digslam.observer.slam.record import MissionRecord
+>>> from digslam.observer.record.mission import MissionRecord
 >>> k, one = np.arange(21), np.ones((21, 1))
 >>> rec = MissionRecord(t=0.1 * k, speed=one * [0.49, 0.51], yaw_rate=one * [-0.01, 0.01],
 ...     heading=one * [-1e-3, 1e-3], alpha=0 * one, gamma=np.pi * one, r_max=5 * one,
@@ -66,6 +66,8 @@ from digslam.observer.online.smooth_jit import (
     sweep,
 )
 from digslam.observer.online.window import WindowDigMap
+from digslam.observer.record.grid import Grid
+from digslam.observer.record.mission import MissionRecord
 from digslam.observer.slam.digslam import (
     DigSlamConfig,
     DigSlamResult,
@@ -73,9 +75,7 @@ from digslam.observer.slam.digslam import (
     odometry_increment,
     odometry_velocity,
 )
-from digslam.observer.slam.grid import Grid
-from digslam.observer.slam.record import MissionRecord
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 from digslam.observer.tube.tube import Tube, ctc_deriv, heading_from_compass
 
 __all__ = ["dig_slam", "impact_radius"]

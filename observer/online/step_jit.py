@@ -29,7 +29,7 @@ builds them inside, which numba's dispatcher types several times faster (a named
 field by field in Python, a plain tuple in C: about 2.5 µs less per call for these three).
 
 >>> from digslam.observer.online.window import grid_frame
->>> from digslam.observer.slam.grid import Grid
+>>> from digslam.observer.record.grid import Grid
 >>> g = Grid((-3.0, -3.0), (3.0, 3.0), (60, 60))
 >>> free, sure, maybe = (np.zeros(g.shape, bool) for _ in range(3))
 >>> cells = CellSets(free, sure, maybe, np.zeros((2, 1, 1), np.int32), np.zeros(1, np.int32))

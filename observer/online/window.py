@@ -41,8 +41,8 @@ from digslam.observer.core import rounding as rnd
 from digslam.observer.online import pose_jit
 from digslam.observer.online.dig_jit import GridFrame, PoseBox, SectorBatch, dig_batch
 from digslam.observer.online.mark_jit import mark_batch
+from digslam.observer.record.grid import Grid
 from digslam.observer.slam.digmap import EDT_SLACK, DigMap
-from digslam.observer.slam.grid import Grid
 
 __all__ = ["WindowDigMap", "grid_frame", "mark_possibly_sensed", "MARGIN"]
 

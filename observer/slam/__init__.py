@@ -1,7 +1,6 @@
 """Offline SLAM on a mission record (Ch. 6): from the record to the dig map, the tube and the explored zone.
 
-Lives here: :mod:`.record` (``MissionRecord``, the data contract between a simulator or robot and the
-observers), :mod:`.grid` (the observer's grid), :mod:`.digmap` (``DigMap``, the dig zone M-, Sec. 6.3),
+Lives here: :mod:`.digmap` (``DigMap``, the dig zone M-, Sec. 6.3),
 :mod:`.digslam` (Dig-SLAM's settings, result and tube pieces, and Alg. 6.3 as the thesis writes it),
 :mod:`.explored` and :mod:`.explored_sweep` (the explored zone as a thick set, App. B.5), :mod:`.landmarks`
 (landmark localization, Ex. 3.4), :mod:`.shapes` (sonar measurement shapes), :mod:`.shape_registration` and
@@ -58,9 +57,6 @@ from .explored_sweep import (
     explored_sweep_grid,
     sweep_gates,
 )
-from .grid import (
-    Grid,
-)
 from .landmarks import (
     CtcLandmarks,
     IterationStats,
@@ -68,9 +64,6 @@ from .landmarks import (
     contract_detections,
     contract_disjunctive,
     localize,
-)
-from .record import (
-    MissionRecord,
 )
 from .shape_registration import (
     SepTranslationInclusion,
@@ -100,12 +93,10 @@ __all__ = [
     "EDT_SLACK",
     "ExplicitSlamConfig",
     "ExplicitSlamResult",
-    "Grid",
     "IterationStats",
     "Localization",
     "MapFunction",
     "Measurements",
-    "MissionRecord",
     "RangeMeasurements",
     "RasterShape",
     "SepExploredDisks",

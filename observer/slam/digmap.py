@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from digslam.observer.core import rounding as rnd
-from digslam.observer.slam.grid import Grid
+from digslam.observer.record.grid import Grid
 
 #: Pairs of (sector, cell) tested at once by :meth:`DigMap.dig_sectors` (memory bound).
 PAIR_CHUNK = 1 << 20

@@ -24,7 +24,7 @@ Data contract (:mod:`.record`): ``speed[k]``, ``lateral[k]`` (the body-frame vel
 A measured odometry increment ``mean_velocity[k]`` also bounds the gate increment
 ``x_k - x_{k-1} ∈ [dt]·R([ψ_{k-1}])·[v̄]`` (:func:`odometry_increment`, used by ``C_d/dt``'s gate passes).
 
->>> from digslam.observer.slam.record import MissionRecord
+>>> from digslam.observer.record.mission import MissionRecord
 >>> n = 11
 >>> rec = MissionRecord(t=np.arange(n) * 0.1, speed=np.tile([0.99, 1.01], (n, 1)),
 ...     yaw_rate=np.tile([-0.01, 0.01], (n, 1)), heading=np.tile([-0.001, 0.001], (n, 1)),
@@ -46,11 +46,11 @@ import numpy as np
 from digslam.observer.core import rounding as rnd
 from digslam.observer.core.config import Config, check, check_finite_nonneg, check_int, config_dataclass
 from digslam.observer.core.types import Pair
+from digslam.observer.record.grid import Grid
+from digslam.observer.record.mission import MissionRecord
 from digslam.observer.slam.digmap import DigMap
 from digslam.observer.slam.explored import explored_disks_grid, explored_union
-from digslam.observer.slam.grid import Grid
-from digslam.observer.slam.record import MissionRecord
-from digslam.observer.thick.sep import CLEAR, DARK, UNKNOWN
+from digslam.observer.thick.cells import CLEAR, DARK, UNKNOWN
 from digslam.observer.tube.ctc import increments
 from digslam.observer.tube.tube import Tube, body_velocity, ctc_deriv, heading_from_compass
 

@@ -57,13 +57,13 @@ from digslam.observer.core import rounding as rnd
 from digslam.observer.core.boxes import empty_rows
 from digslam.observer.core.types import Batch
 from digslam.observer.expr.expr import Function
+from digslam.observer.record.grid import Grid
+from digslam.observer.record.mission import MissionRecord
 from digslam.observer.sets.separators import Sep
 from digslam.observer.slam.digmap import DigMap
 from digslam.observer.slam.digslam import dig_readings, impact_bound, odometry_velocity
-from digslam.observer.slam.grid import Grid
-from digslam.observer.slam.record import MissionRecord
 from digslam.observer.thick.carving import param_hull
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 from digslam.observer.tube.tube import Tube, ctc_deriv, heading_from_compass
 
 __all__ = [

@@ -34,9 +34,10 @@ import numpy as np
 
 from digslam.observer.core import rounding as rnd
 from digslam.observer.core.types import Batch
+from digslam.observer.record.grid import Grid
 from digslam.observer.sets.separators import Sep
-from digslam.observer.slam.grid import Grid
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA, UNKNOWN, ThickSep
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA, UNKNOWN
+from digslam.observer.thick.sep import ThickSep
 
 __all__ = ["explored_disks_grid", "explored_hypotheses", "explored_union", "SepExploredDisks",
            "explored_disks_thick_sep", "explored_thick_sep", "check_tube", "check_interval", "BLOCK", "codes",

@@ -13,7 +13,7 @@ Theorems B.1–B.2, tests B.12 and B.15).
   dark test B.15 asks ``0 ∉ [φ]`` or ``[s] ∩ [s_lo, s_hi] = ∅`` on every gate. Penumbra is not proved
   for sweeps (cells are clear, dark or unknown).
 
->>> from digslam.observer.slam.grid import Grid
+>>> from digslam.observer.record.grid import Grid
 >>> g = Grid((-3.0, -3.0), (3.0, 3.0), (6, 6))
 >>> pos = np.array([[0.0, 0.0]])      # a sonar pie of ±60° facing east, heading in [-0.1, 0.1]
 >>> st = explored_sectors_grid(g, pos - 0.1, pos + 0.1, -0.1, 0.1, 0.0, np.pi / 3, 2.9, 3.2)
@@ -29,6 +29,7 @@ import numpy as np
 
 from digslam.observer.core import rounding as rnd
 from digslam.observer.core import trig
+from digslam.observer.record.grid import Grid
 from digslam.observer.slam.explored import (
     BLOCK,
     check_interval,
@@ -37,8 +38,7 @@ from digslam.observer.slam.explored import (
     pair_test,
     row_intervals,
 )
-from digslam.observer.slam.grid import Grid
-from digslam.observer.thick.sep import CLEAR, DARK, UNKNOWN
+from digslam.observer.thick.cells import CLEAR, DARK, UNKNOWN
 
 __all__ = ["explored_sectors_grid", "explored_sweep_grid", "sweep_gates"]
 

@@ -1,16 +1,16 @@
 """Thick sets (Ch. 5): sets known between an inner and an outer approximation.
 
 Lives here: :mod:`.interval` (thick intervals and Booleans, Sec. 5.2), :mod:`.function` (thick functions),
-:mod:`.sep` (``ThickSep``: clear, penumbra, dark, Sec. 5.3), :mod:`.set` (thick set predicates),
-:mod:`.paver` (``thick_pave``), :mod:`.sivia` (thick SIVIA, Alg. 5.1), :mod:`.subset` (subset-supset
-representation, Fig. A.8), :mod:`.ops` (thick images, products, Minkowski sums), :mod:`.inversion` (thick
-inversion, Sec. 5.4) and :mod:`.carving` (thick carving and SRAC, Sec. 5.5).
+:mod:`.cells` (the cell codes clear, penumbra, dark and unknown, Eq. 5.4), :mod:`.sep` (``ThickSep``, Sec.
+5.3), :mod:`.set` (thick set predicates), :mod:`.paver` (``thick_pave``), :mod:`.sivia` (thick SIVIA, Alg.
+5.1), :mod:`.subset` (subset-supset representation, Fig. A.8), :mod:`.ops` (thick images, products, Minkowski
+sums), :mod:`.inversion` (thick inversion, Sec. 5.4) and :mod:`.carving` (thick carving and SRAC, Sec. 5.5).
 
 May import: :mod:`digslam.observer.core`, :mod:`~digslam.observer.expr`, :mod:`~digslam.observer.sets`,
 :mod:`~digslam.observer.paving`; numpy.
 """
 
-# UNKNOWN is the classification code of .sep (0); the thick Boolean's unknown (-1) is .interval.UNKNOWN.
+# UNKNOWN is the cell code of .cells (0); the thick Boolean's unknown (-1) is .interval.UNKNOWN.
 from .carving import (
     SRACResult,
     ctc_image_equal,
@@ -21,6 +21,7 @@ from .carving import (
     param_hull,
     srac,
 )
+from .cells import CLEAR, DARK, PENUMBRA, UNKNOWN
 from .function import (
     ThickFunction,
 )
@@ -48,10 +49,6 @@ from .paver import (
     thick_pave,
 )
 from .sep import (
-    CLEAR,
-    DARK,
-    PENUMBRA,
-    UNKNOWN,
     ThickSep,
     thick_classify_grid,
     thick_relaxed_intersection,

@@ -22,7 +22,7 @@ import numpy as np
 
 from digslam.observer.core.boxes import empty_rows, validate_batch, volume
 from digslam.observer.core.types import Batch
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 
 
 class ThickTest(Protocol):

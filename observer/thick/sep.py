@@ -22,8 +22,7 @@ import numpy as np
 from digslam.observer.core.boxes import empty_rows, normalize_empty
 from digslam.observer.core.types import Batch
 from digslam.observer.sets.separators import Sep, SepInter, SepNot, SepQInter, SepUnion
-
-CLEAR, DARK, PENUMBRA, UNKNOWN = np.int8(1), np.int8(-1), np.int8(2), np.int8(0)
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA, UNKNOWN
 
 
 class ThickSep:
@@ -138,5 +137,5 @@ def thick_classify_grid(x0: Any, tsep: ThickSep, shape: tuple[int, int]) -> np.n
     return tsep.classify(lo, hi).reshape(ny, nx)
 
 
-__all__ = ["CLEAR", "DARK", "PENUMBRA", "UNKNOWN", "ThickSep", "thick_classify_grid",
+__all__ = ["ThickSep", "thick_classify_grid",
            "thick_relaxed_intersection"]  # fmt: skip

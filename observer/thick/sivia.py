@@ -29,10 +29,10 @@ from typing import Any
 import numpy as np
 
 from digslam.observer.core import rounding as rnd
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA, UNKNOWN
 from digslam.observer.thick.function import ThickFunction
 from digslam.observer.thick.interval import FALSE, TRUE, ThickIntervalArray, thin
 from digslam.observer.thick.paver import ThickPaving, thick_pave
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA, UNKNOWN
 
 _ETA = 2.0**-1070  # absolute error allowance of ThickFunction.approx (underflow)
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from example_loader import load
 
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 from digslam.observer.thick.sivia import ThickInverse
 
 TC1 = load("a5_test_case1_translation")

@@ -15,7 +15,7 @@ from digslam.agents.baselines import make_baseline
 from digslam.envs.dig_coverage.wrapper import reachable_free
 from digslam.envs.sim.raster import FREE, MIXED, rasterize
 from digslam.envs.sim.world import World
-from digslam.observer.slam.grid import Grid
+from digslam.observer.record.grid import Grid
 
 FRAME = (-2.0, -2.0, 2.0, 2.0)
 CELL = 0.25

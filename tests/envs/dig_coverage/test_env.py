@@ -20,8 +20,8 @@ from digslam.envs import (
 )
 from digslam.envs.dig_coverage.maps_jit import three_state
 from digslam.observer.online.observer import OnlineConfig
-from digslam.observer.slam.record import MissionRecord
-from digslam.observer.thick.sep import DARK
+from digslam.observer.record.mission import MissionRecord
+from digslam.observer.thick.cells import DARK
 
 COVERAGE_IDS = list(digslam.envs.COVERAGE_IDS)
 
@@ -304,8 +304,8 @@ def test_sb3_ppo_learns_a_few_hundred_steps() -> None:
 def test_offline_observer_on_a_re_indexed_env_mission_contains_the_truth() -> None:
     from digslam.envs import record_episode
     from digslam.observer.online.smoother import dig_slam
+    from digslam.observer.record.grid import Grid
     from digslam.observer.slam.digslam import DigSlamConfig
-    from digslam.observer.slam.grid import Grid
 
     env = ExploreEnv(world="rocks", noise={"model": "adversarial"})
     ep = record_episode(env, 4, _actions(40, 6))

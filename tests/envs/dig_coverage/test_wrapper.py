@@ -7,7 +7,7 @@ import numpy as np
 from digslam.envs.dig_coverage.env import DigCoverageEnv
 from digslam.envs.dig_coverage.maps_jit import MapPlanes, map_context, observe
 from digslam.envs.sim.world import World
-from digslam.observer.slam.grid import Grid
+from digslam.observer.record.grid import Grid
 
 #: The thesis room's wall (the room generator's world at jitter 0).
 ROOM = np.array([(-9, -9), (-3, -8), (1, -9.2), (8.5, -8), (9, -2), (6, 1), (9.2, 5), (7, 9), (1, 8.5), (-1, 5),

@@ -13,7 +13,7 @@ from gymnasium.utils.env_checker import check_env
 
 import digslam.envs
 from digslam.envs import Episode, ExploreConfig, ExploreEnv, record_episode, replay
-from digslam.observer.slam.record import MissionRecord
+from digslam.observer.record.mission import MissionRecord
 
 IDS = list(digslam.envs.ENV_IDS)
 

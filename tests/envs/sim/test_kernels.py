@@ -17,7 +17,7 @@ from digslam.envs.sim import geometry as geo
 from digslam.envs.sim.arc_jit import arc
 from digslam.envs.sim.robot import FRACTIONS, SWEEP_POINTS, RobotSim
 from digslam.envs.sim.sensors import measure_step
-from digslam.observer.slam.record import MissionRecord
+from digslam.observer.record.mission import MissionRecord
 
 
 # --- numpy oracles (the previous implementations) ----------------------------------------------------------

@@ -38,7 +38,7 @@ from digslam.observer.online.cones_jit import (
     contract_cones,
 )
 from digslam.observer.online.window import grid_frame
-from digslam.observer.slam.grid import Grid
+from digslam.observer.record.grid import Grid
 
 TWO_PI = 2.0 * math.pi
 
@@ -611,7 +611,7 @@ CONTRADICTION = """
 import math, numpy as np
 from digslam.observer.online.cones_jit import contract_cones
 from digslam.observer.online.window import grid_frame
-from digslam.observer.slam.grid import Grid
+from digslam.observer.record.grid import Grid
 g = grid_frame(Grid((0.0, 0.0), (4.0, 4.0), (40, 40)))
 free = np.zeros((40, 40), bool)
 free[:, 10:30] = True

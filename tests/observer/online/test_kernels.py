@@ -30,9 +30,9 @@ from digslam.observer.online.dig_jit import PoseBox, StepRecord
 from digslam.observer.online.observer import OnlineDigSlam
 from digslam.observer.online.pose_jit import TRIG_PAD, cos_sin, predict, rotate
 from digslam.observer.online.window import MARGIN, WindowDigMap, mark_possibly_sensed
+from digslam.observer.record.grid import Grid
 from digslam.observer.slam.digmap import EDT_SLACK, DigMap
-from digslam.observer.slam.grid import Grid
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 
 G = Grid((-6.0, -6.0), (6.0, 6.0), (96, 96))
 PI_40 = Fraction("3.1415926535897932384626433832795028841971")  # π to 40 digits

@@ -19,7 +19,7 @@ import digslam.envs  # noqa: F401  (registers the environments)
 from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.missions import loop_mission
 from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam
-from digslam.observer.slam.grid import Grid
+from digslam.observer.record.grid import Grid
 
 
 @pytest.mark.parametrize(("world", "seed"), [("rooms", 961000), ("rocks", 961001), ("caves", 961002)])

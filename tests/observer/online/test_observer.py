@@ -16,10 +16,10 @@ from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam
 from digslam.observer.online.pose_jit import cos_sin
 from digslam.observer.online.smoother import dig_slam
 from digslam.observer.online.window import WindowDigMap, mark_possibly_sensed
+from digslam.observer.record.grid import Grid
+from digslam.observer.record.mission import MissionRecord
 from digslam.observer.slam.digmap import DigMap
-from digslam.observer.slam.grid import Grid
-from digslam.observer.slam.record import MissionRecord
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 
 CELL = 0.1
 GRID = Grid.from_cell_size((-10.0, -10.0), (10.0, 10.0), CELL)

@@ -29,7 +29,7 @@ from digslam.envs.explore.env import ExploreEnv
 from digslam.envs.sim.noise import outliers
 from digslam.observer.online.observer import OnlineConfig
 from digslam.observer.online.pose_jit import impact_bound, impact_bound_q
-from digslam.observer.slam.record import MissionRecord
+from digslam.observer.record.mission import MissionRecord
 
 #: Digests of ``run(square_room_records(seed, 300))`` computed with the filter before the q-relaxed mode.
 OLD_DIGESTS = {

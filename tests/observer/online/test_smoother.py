@@ -22,9 +22,9 @@ from hypothesis import strategies as st
 from digslam.envs import ExploreEnv, record_episode
 from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam
 from digslam.observer.online.smoother import dig_slam
+from digslam.observer.record.grid import Grid
 from digslam.observer.slam.digslam import DigSlamConfig
-from digslam.observer.slam.grid import Grid
-from digslam.observer.thick.sep import CLEAR, DARK
+from digslam.observer.thick.cells import CLEAR, DARK
 
 CELL = 0.125
 

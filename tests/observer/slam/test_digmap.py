@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from digslam.observer.record.grid import Grid
 from digslam.observer.slam.digmap import DigMap
-from digslam.observer.slam.grid import Grid
 
 GRID = Grid((-3.0, -2.0), (3.0, 2.5), (45, 60))
 

@@ -15,9 +15,9 @@ from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.missions import loop_mission
 from digslam.envs.sim.sensors import SensorSuite
 from digslam.observer.online.smoother import dig_slam
+from digslam.observer.record.grid import Grid
+from digslam.observer.record.mission import MissionRecord
 from digslam.observer.slam.digslam import DigSlamConfig, thesis_dig_slam
-from digslam.observer.slam.grid import Grid
-from digslam.observer.slam.record import MissionRecord
 
 CELL = 0.1
 GRID = Grid.from_cell_size((-10.0, -10.0), (10.0, 10.0), CELL)
@@ -82,7 +82,7 @@ def truly_sensed(p: np.ndarray, rec: MissionRecord, truth: np.ndarray, suite: Se
 def assert_explored_sound(st: np.ndarray, rec: MissionRecord, truth: np.ndarray, suite: SensorSuite,
                           rng: np.random.Generator) -> None:  # fmt: skip
     """Clear cells were truly sensed, dark cells never; every truly sensed point is in a non-dark cell."""
-    from digslam.observer.thick.sep import CLEAR, DARK
+    from digslam.observer.thick.cells import CLEAR, DARK
 
     for code, want in ((CLEAR, True), (DARK, False)):
         rows, cols = np.nonzero(st == code)
@@ -201,9 +201,9 @@ def test_the_odometry_increment_keeps_the_offline_tube_narrow_under_pymunk() -> 
     reported as an inconsistency."""
     from digslam.envs import ExploreEnv
     from digslam.envs.explore.episode import record_episode
+    from digslam.observer.record.grid import Grid
+    from digslam.observer.record.mission import MissionRecord
     from digslam.observer.slam.digslam import DigSlamConfig, odometry_increment
-    from digslam.observer.slam.grid import Grid
-    from digslam.observer.slam.record import MissionRecord
 
     rng = np.random.default_rng(3)
     env = ExploreEnv(world="rocks")

@@ -10,6 +10,7 @@ from example_loader import load
 
 from digslam.envs.sim.missions import loop_mission
 from digslam.envs.sim.sensors import SensorSuite
+from digslam.observer.record.grid import Grid
 from digslam.observer.slam.digslam import DigSlamConfig
 from digslam.observer.slam.digslam import thesis_dig_slam as dig_slam
 from digslam.observer.slam.explicit_slam import (
@@ -24,7 +25,6 @@ from digslam.observer.slam.explicit_slam import (
     shape_carve,
     shape_register,
 )
-from digslam.observer.slam.grid import Grid
 from digslam.observer.slam.shape_slam import ShapeSlamConfig, shape_slam
 from digslam.observer.tube.tube import Tube
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from digslam.observer.record.grid import Grid
 from digslam.observer.slam.explored import (
     SepExploredDisks,
     explored_disks_grid,
@@ -18,8 +19,8 @@ from digslam.observer.slam.explored import (
     explored_thick_sep,
 )
 from digslam.observer.slam.explored_sweep import explored_sectors_grid, explored_sweep_grid, sweep_gates
-from digslam.observer.slam.grid import Grid
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA, ThickSep, thick_classify_grid
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.sep import ThickSep, thick_classify_grid
 
 GRID = Grid((-6.0, -6.0), (6.0, 6.0), (48, 48))
 

@@ -15,7 +15,7 @@ from digslam.observer.slam.shape_registration import (
     register_translation,
 )
 from digslam.observer.slam.shape_slam import ShapeSlamConfig, ctc_minus, overlap_pretest, shape_slam
-from digslam.observer.thick.sep import CLEAR, DARK
+from digslam.observer.thick.cells import CLEAR, DARK
 from digslam.observer.tube.tube import Tube
 
 GRAD = 1 / 3 + 1 / 2.5 + 0.5 * np.sqrt(2) / 4  # bound of |∇z|₂ for the field below

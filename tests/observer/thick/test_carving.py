@@ -22,7 +22,8 @@ from digslam.observer.thick.carving import (
     param_hull,
     srac,
 )
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA, ThickSep
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
+from digslam.observer.thick.sep import ThickSep
 
 CA, CB = np.array([0.0, 0.0]), np.array([2.0, 1.0])  # centres of [A] and [B]: the true p is about CB - CA
 P0 = [(-1.0, 4.0), (-2.0, 3.0)]

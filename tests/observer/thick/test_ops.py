@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from digslam.observer import Box, Function, Interval, SepBox, SepInverse, Transform
+from digslam.observer.thick.cells import CLEAR, DARK
 from digslam.observer.thick.ops import thick_image, thick_image_param, thick_minkowski_sum, thick_product
-from digslam.observer.thick.sep import CLEAR, DARK, ThickSep
+from digslam.observer.thick.sep import ThickSep
 
 Pred = Callable[[np.ndarray], np.ndarray]
 RNG_SEED = 7

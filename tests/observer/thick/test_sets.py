@@ -8,10 +8,8 @@ import numpy as np
 import pytest
 
 from digslam.observer import Box, SepBox
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 from digslam.observer.thick.sep import (
-    CLEAR,
-    DARK,
-    PENUMBRA,
     ThickSep,
     thick_classify_grid,
     thick_relaxed_intersection,

@@ -16,9 +16,9 @@ import pytest
 from example_loader import load
 
 from digslam.observer import Box, Function
+from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA, UNKNOWN
 from digslam.observer.thick.function import ThickFunction
 from digslam.observer.thick.paver import ThickPaving
-from digslam.observer.thick.sep import CLEAR, DARK, PENUMBRA, UNKNOWN
 from digslam.observer.thick.sivia import ThickInverse, thick_sivia
 
 Bounds = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
