@@ -294,9 +294,12 @@ GENERATORS: dict[str, type[WorldGenerator]] = {
     "file": FileMap,
     "mixed": Mixed,
 }
+#: The generators of the coverage benchmark (:mod:`digslam.agents.evaluation.suite`), in its column order.
+BENCHMARK: tuple[str, ...] = ("room", "rocks", "caves", "rooms")
 
 
 __all__ = [
+    "BENCHMARK",
     "Caves",
     "FileMap",
     "GENERATORS",
