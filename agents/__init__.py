@@ -3,11 +3,13 @@
 Names are imported on first use, so ``import digslam.agents`` needs neither torch nor stable-baselines3
 (those are imported inside the functions that train or load a learned policy).
 
-Folders: :mod:`~digslam.agents.baselines` (heuristic agents), :mod:`~digslam.agents.goals` (the
-goal-selection env ``digslam/DigCoverageGoals-v0``: candidate goals driven by the frontier agent's loop,
-registered when that folder is imported), :mod:`~digslam.agents.learning` (training, sweeps, the shipped
-model), :mod:`~digslam.agents.evaluation` (evaluation, pictures) and :mod:`~digslam.agents.cli` (the command
-line, the only place that wires argparse). The evaluation function
+Folders: :mod:`~digslam.agents.common` (what several parts share: the policy contract
+``PolicyPredictor``), :mod:`~digslam.agents.baselines` (heuristic agents), :mod:`~digslam.agents.goals`
+(the goal-selection env ``digslam/DigCoverageGoals-v0``: candidate goals driven by the frontier agent's
+loop, registered when that folder is imported), :mod:`~digslam.agents.learning` (training, sweeps, the
+shipped models), :mod:`~digslam.agents.prediction` (the map predictor and the agent that plans on it),
+:mod:`~digslam.agents.evaluation` (evaluation, the benchmark suite, pictures) and
+:mod:`~digslam.agents.cli` (the command line, the only place that wires argparse). The evaluation function
 is exported as :func:`evaluate_agents` (``digslam.agents.evaluation.evaluate`` is its module).
 """
 
@@ -30,11 +32,17 @@ _LAZY = {
     "RandomAgent": "baselines",
     "UncertaintyAwareFrontier": "baselines",
     "make_baseline": "baselines",
+    "PolicyPredictor": "common",
     "FirstCandidatePolicy": "goals",
+    "GoalAgent": "goals",
     "GoalSelectionEnv": "goals",
+    "TrainConfig": "learning.train_config",
+    "train": "learning.train",
     "EvalResult": "evaluation.evaluate",
     "coverage_figure": "evaluation.evaluate",
     "evaluate_agents": "evaluation.evaluate",
+    "SuiteResult": "evaluation.suite",
+    "run_suite": "evaluation.suite",
     "record_episode_gif": "evaluation.pictures",
 }
 

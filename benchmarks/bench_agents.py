@@ -94,7 +94,7 @@ def env_settings(items: list[str]) -> dict[str, Any]:
     Raises:
         ValueError: an item without ``=``.
     """
-    from digslam.agents.learning.train import parse_value
+    from digslam.observer.core.config import parse_value
 
     out: dict[str, Any] = {}
     for item in items:

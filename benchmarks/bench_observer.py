@@ -10,8 +10,7 @@ Measurement: the two envs run the same actions, reset with the same seeds at the
 excluded), after an untimed warm-up of 50 steps each. To keep a load spike on a shared machine from landing
 on one env only, the timed steps alternate between them in chunks of ``--chunk`` steps (raw chunk, then
 the same steps on the observed env, then the next chunk...); each env's time is the total over its chunks
-and the overhead is the ratio of the two totals. (Before, the raw run and the observed run were timed one
-after the other, each in one piece; the envs, actions, seeds and defaults compared are unchanged.)
+and the overhead is the ratio of the two totals.
 
 The observed env runs twice, with the filter's q-relaxed mode off (``q = 0``, the figures above) and at
 ``q = 1`` (at most one outlier among each step's readings, thesis §2.6.2: a cell is dug where two readings
@@ -45,17 +44,10 @@ import gymnasium as gym
 import numpy as np
 
 import digslam.envs  # noqa: F401  (registers the environments)
+from digslam.envs.stack import observer_of
 
 #: The loop-closure smoothing of the ``_loop`` figures (:mod:`digslam.observer.online.history`).
 LOOP = {"loop_smoothing": 0.3, "history": 4000}
-
-
-def filter_layer(env: gym.Env) -> gym.Env:
-    """The wrapper layer that holds the online filter."""
-    layer = env
-    while not hasattr(layer, "filter"):
-        layer = layer.env
-    return layer
 
 
 def timed(env: gym.Env, actions: np.ndarray, probe: list[float] | None = None) -> float:
@@ -65,7 +57,7 @@ def timed(env: gym.Env, actions: np.ndarray, probe: list[float] | None = None) -
         for a in actions:
             env.step(a)
         return time.perf_counter() - t0
-    f = filter_layer(env).filter
+    f = observer_of(env).filter
     t0 = time.perf_counter()
     for a in actions:
         env.step(a)
@@ -106,7 +98,7 @@ def loop_on_frontier(steps: int) -> tuple[int, np.ndarray, float, float]:
         agent = make_baseline("frontier", env)
         agent.reset()
         o, info = env.reset(seed=int(seeds("test", 1)[0]))
-        f, times = filter_layer(env).filter, []
+        f, times = observer_of(env).filter, []
         for _ in range(steps):
             a, _ = agent.predict(o, deterministic=True)
             o, _, term, trunc, info = env.step(np.clip(np.asarray(a, np.float32), -1.0, 1.0))
@@ -158,7 +150,7 @@ def main() -> None:
     t_raw_u, t_obs_u = run_pair(raw_u, [obs_u], actions, args.episode, args.chunk, probe_u)
     up_u = np.array(probe_u[0])
     raw_sps_u, obs_sps_u = args.steps / t_raw_u, args.steps / t_obs_u
-    layer = filter_layer(obs)
+    layer = observer_of(obs)
     print(f"grid={layer.grid.shape} map={layer.obs_config.map_size} sensors={raw.unwrapped.suite.n}")
     print(f"raw_steps_per_s={raw_sps:.0f}")
     print(f"observed_steps_per_s_q1={obs1_sps:.0f}")
@@ -170,7 +162,7 @@ def main() -> None:
     print(f"observed_steps_per_s_loop={obs_l_sps:.0f}")
     print(f"observer_update_p99_ms_loop={1e3 * np.percentile(up_l, 99):.3f}")
     print(f"observer_update_max_ms_loop={1e3 * up_l.max():.3f}")
-    print(f"loop_passes_last_episode={filter_layer(obs_l).filter.history.passes}")
+    print(f"loop_passes_last_episode={observer_of(obs_l).filter.history.passes}")
     print(f"observer_overhead_loop={raw_sps / obs_l_sps:.3f}")
     passes, up_f, cov0, cov1 = loop_on_frontier(300 if args.quick else 3000)
     print(f"loop_frontier_passes={passes}")

@@ -24,9 +24,10 @@ import numpy as np
 
 from digslam.agents.prediction import dataset, quality
 from digslam.agents.prediction.model import SHIPPED, load
+from digslam.envs.sim.generators import BENCHMARK
 from digslam.envs.splits import seeds
 
-GENERATORS = ["room", "rocks", "caves", "rooms"]
+GENERATORS = list(BENCHMARK)
 
 
 def main() -> None:

@@ -26,7 +26,9 @@ import time
 
 import numpy as np
 
-from digslam.agents.evaluation.ray_eval import build_policy, run_suite_ray, start_ray
+from digslam.agents.evaluation.ray_eval import run_suite_ray
+from digslam.agents.evaluation.ray_pool import start_ray
+from digslam.agents.evaluation.specs import build_policy
 from digslam.agents.evaluation.suite import GENERATORS, run_suite
 
 ENV = "digslam/DigCoverage-v0"

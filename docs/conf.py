@@ -22,7 +22,7 @@ extensions = [
     "digslam_docs",
 ]
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
-exclude_patterns = ["_build", "make_gallery.py", "_ext"]
+exclude_patterns = ["_build", "make_gallery.py", "_ext", "_generated"]
 myst_enable_extensions = ["colon_fence", "deflist", "dollarmath"]
 myst_heading_anchors = 3
 

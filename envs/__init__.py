@@ -10,6 +10,10 @@ new reachable start pose (a level), and :mod:`.splits` fixes the train, validati
 (``ExploreConfig.map_seed`` pins one world for debugging). In worker processes that
 have not imported it (e.g. SB3's ``SubprocVecEnv`` with forkserver), use the
 ``"digslam.envs:digslam/Explore-v0"`` form, which imports the module first.
+
+The certified-coverage observation is laid out once in :mod:`.observation` (:class:`Channel`,
+:class:`State`); :func:`observer_of` finds the observer layer of a stack of wrappers (:mod:`.stack`); the
+worlds are named in one registry, :data:`GENERATORS`.
 """
 
 from __future__ import annotations
@@ -20,9 +24,13 @@ from digslam.envs.config import ExploreConfig, NoiseConfig
 from digslam.envs.explore.env import ExploreEnv
 from digslam.envs.explore.episode import Episode, record_episode, replay
 from digslam.envs.explore.truth import GroundTruth
+from digslam.envs.observation import N_STATE, Channel, State
 from digslam.envs.sim.generators import (
+    BENCHMARK,
+    GENERATORS,
     Caves,
     FileMap,
+    Generator,
     Mixed,
     RockField,
     RoomsCorridors,
@@ -31,6 +39,7 @@ from digslam.envs.sim.generators import (
 )
 from digslam.envs.sim.sensors import SensorSuite
 from digslam.envs.sim.world import World
+from digslam.envs.stack import find_wrapper, observer_of
 from digslam.observer.cache import origin as _origin  # a shadowing source folder is reported in one line
 
 _origin.warn_if_shadowed(__name__)
@@ -67,7 +76,7 @@ COVERAGE_IDS: dict[str, dict[str, object]] = {
 
 for _ids, _entry in (
     (ENV_IDS, "digslam.envs.explore.env:ExploreEnv"),
-    (COVERAGE_IDS, "digslam.envs.dig_coverage.env:DigCoverageEnv"),  # it holds the id's spec
+    (COVERAGE_IDS, "digslam.envs.dig_coverage.env:DigCoverageEnv"),
 ):
     for _id, _kw in _ids.items():
         if _id not in gym.registry:
@@ -94,7 +103,15 @@ def __getattr__(name: str) -> object:
 
 
 __all__ = [
+    "BENCHMARK",
     "COVERAGE_IDS",
+    "Channel",
+    "GENERATORS",
+    "Generator",
+    "N_STATE",
+    "State",
+    "find_wrapper",
+    "observer_of",
     "DigCoverageConfig",
     "DigCoverageEnv",
     "GuaranteeMonitor",

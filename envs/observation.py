@@ -3,7 +3,7 @@
 Every ``digslam/DigCoverage-*`` env (:class:`~digslam.envs.dig_coverage.wrapper.GuaranteedObserver`)
 returns ``{"map": uint8 (C, m, m), "state": float32 (N_STATE,)}``. This module is the one place that says
 what each channel and each state entry means: the observation space (:func:`observation_space`), the
-compiled writer (:mod:`digslam.envs.dig_coverage.maps_jit`), the agents' parsers and the docs' table
+compiled writer (:mod:`digslam.envs.dig_coverage.observe_jit`), the agents' parsers and the docs' table
 (:func:`markdown_table`) all read it.
 
 ``"map"`` is a channels-first image (SB3's image convention, values 0 or 255) over the grid's frame, row 0
@@ -85,7 +85,7 @@ STATES: dict[State, str] = {
 #: Length of ``obs["state"]``.
 N_STATE = len(State)
 #: Channels without and with ``crop``.
-BASE_CHANNELS, CROP_CHANNELS = 4, 7
+BASE_CHANNELS, CROP_CHANNELS = int(Channel.POSE) + 1, len(Channel)
 
 
 def n_channels(crop: bool) -> int:

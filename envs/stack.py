@@ -14,9 +14,11 @@ its filter, its configuration) and says in one line when there is none.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, TypeVar
 
 if TYPE_CHECKING:
+    import gymnasium as gym
+
     from digslam.envs.dig_coverage.wrapper import GuaranteedObserver
 
 L = TypeVar("L")
@@ -24,10 +26,10 @@ L = TypeVar("L")
 MAX_DEPTH = 64
 
 
-def find_wrapper(env: Any, cls: type[L]) -> L | None:
+def find_wrapper(env: gym.Env, cls: type[L]) -> L | None:
     """The outermost layer of ``env`` (``env`` itself, then ``env.env``, ...) that is an instance of
     ``cls``, or None when no layer is."""
-    e = env
+    e: object = env
     for _ in range(MAX_DEPTH):
         if isinstance(e, cls):
             return e
@@ -37,7 +39,7 @@ def find_wrapper(env: Any, cls: type[L]) -> L | None:
     return None
 
 
-def observer_of(env: Any) -> GuaranteedObserver:
+def observer_of(env: gym.Env) -> GuaranteedObserver:
     """The :class:`~digslam.envs.dig_coverage.wrapper.GuaranteedObserver` layer of ``env``.
 
     Raises:

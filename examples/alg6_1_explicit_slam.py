@@ -39,12 +39,11 @@ from digslam.observer.record.grid import Grid
 from digslam.observer.slam.explicit_slam import (
     ExplicitSlamConfig,
     ExplicitSlamResult,
-    RangeMeasurements,
-    RasterShape,
-    ShapeMeasurements,
     explicit_slam,
     mission_tube,
 )
+from digslam.observer.slam.measurements import RangeMeasurements, ShapeMeasurements
+from digslam.observer.slam.raster_shape import RasterShape
 from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 
 CELL = 0.25  # pixel side of the shapes and cell side of the map (a dyadic number: exact lattice)

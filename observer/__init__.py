@@ -71,16 +71,8 @@ from digslam.observer.slam.digslam import DigSlamConfig, DigSlamResult
 from digslam.observer.slam.explicit_slam import (
     ExplicitSlamConfig,
     ExplicitSlamResult,
-    MapFunction,
-    RangeMeasurements,
-    RasterShape,
-    SepShapeRegistration,
-    ShapeMeasurements,
-    ThickMap,
     explicit_slam,
     mission_tube,
-    shape_carve,
-    shape_register,
 )
 from digslam.observer.slam.explored import (
     SepExploredDisks,
@@ -99,6 +91,8 @@ from digslam.observer.slam.landmarks import (
     contract_disjunctive,
     localize,
 )
+from digslam.observer.slam.measurements import RangeMeasurements, ShapeMeasurements
+from digslam.observer.slam.raster_shape import RasterShape
 from digslam.observer.slam.shape_registration import (
     SepTranslationInclusion,
     ThickImage,
@@ -112,7 +106,9 @@ from digslam.observer.slam.shape_slam import (
     overlap_pretest,
     shape_slam,
 )
+from digslam.observer.slam.shape_srac import SepShapeRegistration, shape_carve, shape_register
 from digslam.observer.slam.shapes import free_zone, impact_zone, measurement_shapes
+from digslam.observer.slam.thick_map import MapFunction, ThickMap
 from digslam.observer.thick.carving import (
     SRACResult,
     ctc_image_equal,

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import ast
 import importlib
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -154,3 +155,94 @@ def cycles(g: dict[str, set[str]]) -> list[list[str]]:
         if v not in index:
             visit(v)
     return out
+
+
+#: Names through which code reaches the env that a wrapper wraps (``self.env``, ``env.unwrapped``...).
+ENV_NAMES = frozenset({"env", "unwrapped", "raw"})
+
+
+def private_reaches(mod: Module) -> list[tuple[int, str]]:
+    """``(line, text)`` of each private attribute (``_x``, not ``__x__``) read or called through a wrapped env:
+    an expression such as ``self.env._step(...)`` or ``env.unwrapped._spec`` whose chain of names passes
+    through ``env``, ``unwrapped`` or ``raw``."""
+    out = []
+    for node in ast.walk(mod.tree):
+        if not isinstance(node, ast.Attribute):
+            continue
+        name = node.attr
+        if not name.startswith("_") or (name.startswith("__") and name.endswith("__")):
+            continue
+        chain, v = [], node.value
+        while isinstance(v, ast.Attribute):
+            chain.append(v.attr)
+            v = v.value
+        if isinstance(v, ast.Name):
+            chain.append(v.id)
+        if ENV_NAMES & set(chain):
+            out.append((node.lineno, ast.unparse(node)))
+    return sorted(out)
+
+
+#: A Sphinx cross-reference: its role, its text and its explicit target (``text <target>``).
+ROLE = re.compile(r":(mod|class|func|meth|data|attr|exc|obj):`~?([^`<]*?)(?:\s*<([^>]+)>)?`")
+TYPE_IGNORE = re.compile(r"#\s*type:\s*ignore\b(\[[^\]]*\])?(.*)$")
+
+
+def unexplained_ignores(path: Path) -> list[tuple[int, str]]:
+    """``(line, text)`` of each ``# type: ignore`` without an error code and a reason: a comment after it on
+    its line (``# type: ignore[override]  # gymnasium declares spec a property``), or a comment line just
+    above it."""
+    lines = path.read_text().splitlines()
+    out = []
+    for i, line in enumerate(lines):
+        m = TYPE_IGNORE.search(line)
+        if m is None:
+            continue
+        code, rest = m.group(1), m.group(2)
+        above = lines[i - 1].strip() if i else ""
+        reason = bool(re.match(r"\s*#\s*\S", rest)) or (above.startswith("#") and len(above) > 2)
+        if not code or not reason:
+            out.append((i + 1, line.strip()))
+    return out
+
+
+def docstring_references(mods: dict[str, Module]) -> list[tuple[Module, int, str, str]]:
+    """``(module, line, role, target)`` of each Sphinx cross-reference to digslam in the source
+    (``:mod:`digslam.envs.sim```, ``:func:`~.carving.srac```...)."""
+    out = []
+    for m in mods.values():
+        text = m.path.read_text()
+        for r in ROLE.finditer(text):
+            target = (r.group(3) or r.group(2)).strip().lstrip("~")
+            if re.fullmatch(r"\.?[A-Za-z_][\w.]*", target) and (target.startswith((".", "digslam."))):
+                out.append((m, text[: r.start()].count("\n") + 1, r.group(1), target))
+    return out
+
+
+def known_names(mods: dict[str, Module]) -> tuple[set[str], set[str]]:
+    """The full names of every digslam module and of every name defined or imported at the top of one (and
+    of the members of its classes): ``(modules, names)``, each with the ``digslam.`` prefix. Imports every
+    module."""
+    import inspect
+
+    modules, names = set(), set()
+    for m in mods.values():
+        full = f"digslam.{m.name}"
+        modules.add(full)
+        names.add(full)
+        mod = importlib.import_module(full)
+        for k, v in vars(mod).items():
+            names.add(f"{full}.{k}")
+            if inspect.isclass(v):
+                members = [*vars(v), *getattr(v, "__annotations__", {}), *getattr(v, "_fields", ())]
+                names.update(f"{full}.{k}.{a}" for a in members)
+    return modules, names
+
+
+def resolves(role: str, target: str, modules: set[str], names: set[str]) -> bool:
+    """Whether Sphinx can resolve ``target``: a name that starts with ``.`` resolves to any object whose full
+    name ends with it; a ``:mod:`` names a module."""
+    pool = modules if role == "mod" else names
+    if target.startswith("."):
+        return any(n.endswith(target) for n in pool)
+    return target in pool

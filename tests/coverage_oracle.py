@@ -1,5 +1,5 @@
-"""The ground-truth coverage kernel that :func:`digslam.envs.explore.coverage_jit.cover_step` replaced, kept
-here as its oracle: the same decisions cell by cell over the whole window, with no block skipping
+"""The oracle of :func:`digslam.envs.explore.coverage_jit.cover_step`, the ground-truth coverage kernel
+without block skipping: the same decisions cell by cell over the whole window, with no block skipping
 (``tests/envs/explore/test_coverage.py`` checks the two mark the same cells, bit for bit; the numpy
 brute force of that file checks this one).
 

@@ -5,9 +5,7 @@ arithmetic (:mod:`digslam.observer.core.arith`, :mod:`~digslam.observer.core.tri
 pie separator of :class:`~digslam.observer.polar.sep.SepPiInv` and
 :class:`~digslam.observer.polar.sep.SepLandmark` built from it by Theorem 3.2 (:func:`project_contract`):
 the compiled kernels must agree with it up to outward rounding (``tests/observer/polar/test_polar_jit.py``).
-It used to ship in ``digslam.observer.polar`` (``contract_polar``, ``CtcPolarNumpy``, ``separate_numpy``);
-it is never faster than the kernels (20 000 random boxes: 1.7 s against 0.13 s compiled), so only the
-tests run it.
+It is slower than the kernels, so only the tests run it.
 
 How. On the base octant ``x, y, ρ >= 0, θ ∈ [0, π/4]`` every coordinate is monotone along every boundary
 piece of ``[x]×[y] ∩ π([ρ]×[θ])``, so the hull is reached at vertices of that region; the symmetries only

@@ -12,7 +12,19 @@ import re
 from pathlib import Path
 
 import pytest
-from architecture import REPO, cycles, graph, import_dotted, scan, third_party
+from architecture import (
+    REPO,
+    cycles,
+    docstring_references,
+    graph,
+    import_dotted,
+    known_names,
+    private_reaches,
+    resolves,
+    scan,
+    third_party,
+    unexplained_ignores,
+)
 
 MODS = scan()
 
@@ -34,12 +46,14 @@ ALLOWED: dict[str, set[str]] = {
     "envs.explore": {"observer.core", "observer.record", "envs.sim", "envs"},
     "envs.dig_coverage": {"observer.core", "observer.record", "observer.slam", "observer.thick", "observer.online", "envs.sim",
                           "envs.explore", "envs"},
+    "agents.common": set(),
     "agents.baselines": {"observer.core", "envs"},
-    "agents.learning": {"observer.core", "envs", "agents.baselines", "agents.evaluation", "agents.goals"},
-    "agents.evaluation": {"observer.core", "observer.thick", "envs", "envs.sim", "envs.explore",
+    "agents.learning": {"observer.core", "envs", "agents.common", "agents.baselines", "agents.evaluation",
+                        "agents.goals"},
+    "agents.evaluation": {"observer.core", "observer.thick", "envs", "agents.common", "envs.sim", "envs.explore",
                           "envs.dig_coverage", "agents.baselines", "agents.learning"},
-    "agents.goals": {"envs", "agents.baselines"},
-    "agents.prediction": {"observer.core", "envs", "envs.dig_coverage", "agents.baselines", "agents.evaluation",
+    "agents.goals": {"envs", "agents.common", "agents.baselines"},
+    "agents.prediction": {"observer.core", "envs", "agents.common", "envs.dig_coverage", "agents.baselines", "agents.evaluation",
                           "agents.goals", "agents.learning"},
 }  # fmt: skip
 FOLDERS = sorted(m.name for m in MODS.values() if m.is_package and m.name.count(".") == 1)
@@ -119,6 +133,7 @@ def test_the_kernel_rule_test_catches_a_cross_folder_call(tmp_path: Path) -> Non
 
 def test_observer_needs_only_numpy_scipy_numba() -> None:
     allowed = {"numpy", "scipy", "numba", "matplotlib", "mpmath"}  # matplotlib: paving.draw, on use only
+    allowed |= {"typing_extensions"}  # core.config, under TYPE_CHECKING only (never imported at run time)
     stdlib = set(__import__("sys").stdlib_module_names)
     for m in MODS.values():
         if m.name.startswith("observer"):
@@ -172,3 +187,80 @@ def test_every_folder_package_is_installed() -> None:
         for init in (REPO / top).rglob("__init__.py"):
             rel = init.parent.relative_to(REPO).parts
             assert ".".join(("digslam", *rel)) in listed, f"pyproject.toml: add digslam.{'.'.join(rel)}"
+
+
+# --- the house: shared contracts, wrappers, types, sizes --------------------------------------------------
+def test_no_module_is_over_500_lines() -> None:
+    big = {m.name: n for m in MODS.values() if (n := len(m.path.read_text().splitlines())) > 500}
+    assert not big, f"one concept per module: split {big}"
+
+
+def test_no_wrapper_reaches_a_private_name_of_the_env_it_wraps() -> None:
+    """Wrappers use the public API of the env they wrap and ``info``: no ``self.env._step(...)``, no
+    ``env.unwrapped._spec``."""
+    bad = [
+        f"{m.path.relative_to(REPO)}:{line} {text}"
+        for m in MODS.values()
+        for line, text in private_reaches(m)
+    ]
+    assert not bad, "\n".join(bad)
+
+
+def test_the_private_reach_check_catches_a_private_call(tmp_path: Path) -> None:
+    """The checker itself: a call of a private method through ``.env`` or ``.unwrapped`` is reported, one on
+    ``self`` is not."""
+    from architecture import Module
+
+    code = "class W:\n    def step(self, a):\n        self._own()\n        return self.env._step(a, observe=False)\n" \
+           "    def spec(self):\n        return self.env.unwrapped._spec\n"  # fmt: skip
+    m = Module("envs.x", tmp_path / "x.py", False, ast.parse(code))
+    assert [text for _, text in private_reaches(m)] == ["self.env._step", "self.env.unwrapped._spec"]
+
+
+def test_mypy_checks_the_three_packages() -> None:
+    """mypy checks ``digslam.observer``, ``digslam.envs`` and ``digslam.agents`` as one package (its path
+    holds a link to each folder, so imports across them are checked, not taken as ``Any``), and CI runs it."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
+        import tomli as tomllib  # type: ignore[no-redef]  # the same API under the backport's name
+    cfg = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["mypy"]
+    assert set(cfg["packages"]) == {f"digslam.{p}" for p in ("observer", "envs", "agents")}, cfg
+    for top in ("observer", "envs", "agents"):
+        link = REPO / cfg["mypy_path"] / "digslam" / top
+        assert link.resolve() == (REPO / top).resolve(), f"{link} must link to {top}/"
+    ci = (REPO / ".ci" / "run").read_text()
+    assert re.search(r"^mypy\b", ci, re.M), ".ci/run runs mypy on pyproject's packages"
+
+
+def test_every_type_ignore_has_a_code_and_a_reason() -> None:
+    bad = [f"{m.path.relative_to(REPO)}:{line} {text}" for m in MODS.values()
+           for line, text in unexplained_ignores(m.path)]  # fmt: skip
+    assert not bad, "say why, after the ignore or on the line above:\n" + "\n".join(bad)
+
+
+def test_every_docstring_reference_names_something_that_exists() -> None:
+    """A ``:mod:``/``:func:``/``:class:``... reference to digslam names a module or an object that exists (a
+    target that starts with ``.`` as Sphinx resolves it: any full name that ends with it)."""
+    modules, names = known_names(MODS)
+    bad = [f"{m.path.relative_to(REPO)}:{line} :{role}:`{target}`"
+           for m, line, role, target in docstring_references(MODS)
+           if not resolves(role, target, modules, names)]  # fmt: skip
+    assert not bad, "\n".join(bad)
+
+
+def test_the_layout_page_states_each_folders_imports() -> None:
+    """``docs/layout.md`` lists every concept folder with what it may import, as :data:`ALLOWED` does."""
+    text = (REPO / "docs" / "layout.md").read_text()
+    rows = dict(re.findall(r"^\| `([a-z_/]+)` \|[^|]*\| ([^|]+) \|$", text, re.M))
+    for folder, allowed in ALLOWED.items():
+        row = rows.get(folder.replace(".", "/"))
+        assert row is not None, f"docs/layout.md: add a row for {folder.replace('.', '/')}"
+        stated = (
+            set()
+            if row.strip() == "nothing"
+            else {s.replace("/", ".") for s in re.findall(r"`([a-z_/]+)`", row)}
+        )
+        assert stated == allowed, (
+            f"docs/layout.md, {folder}: states {sorted(stated)}, the rule is {sorted(allowed)}"
+        )

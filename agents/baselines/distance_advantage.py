@@ -23,20 +23,23 @@ and the nearer one wins.
   the unnavigable edge of the clear zone cost more); ``d(x, s)`` is the frontier agent's path length;
 * a pixel of cluster ``s`` costs ``frontier cost - advantage_weight * min_{s'} d(s', s)``, so with weight 1
   the cheapest cluster is the one of largest ``A(s)`` up to the frontier agent's own terms; the default,
-  0.4, tuned on the validation levels, weighs the isolation less than the paper.
+  0.4, weighs the isolation less than the paper.
 
 Where it differs from the paper: the frontier agent's turn and expected-gain terms stay in the cost (the
 paper's candidates are filtered by gain, ours are weighted by it), the candidates are clusters of pixels
 rather than viewpoints, a candidate with no other one in reach has no advantage term (``A`` is undefined
 for a lone frontier), the other tiers of the frontier agent (penumbra, unvisited ground) come after the
-clusters as before, and the goal keeps the frontier agent's hysteresis (:func:`~.frontier.keep_bound`).
+clusters as before, and the goal keeps the frontier agent's hysteresis (:func:`~.navigating.keep_bound`).
 
 >>> from gymnasium import spaces
+>>> from digslam.envs.observation import N_STATE, Channel, State
 >>> agent = DistanceAdvantageAgent(spaces.Box(-1, 1, (2,)))
->>> state = np.zeros(11, np.float32); state[[4, 10]] = 1.0; state[8] = 0.1    # centre, heading +x
->>> img = np.zeros((4, 36, 36), np.uint8); img[0, 8:28, 8:28] = 255; img[2] = 255 - img[0]
+>>> state = np.zeros(N_STATE, np.float32); state[[State.COS, State.CONSISTENT]] = 1.0   # centre, heading +x
+>>> state[State.ELAPSED] = 0.1
+>>> img = np.zeros((4, 36, 36), np.uint8); img[Channel.CLEAR, 8:28, 8:28] = 255
+>>> img[Channel.DARK] = 255 - img[Channel.CLEAR]
 >>> a, _ = agent.predict({"map": img, "state": state})
->>> agent._mem[0].goal is not None, a.shape
+>>> agent.memory(0).goal is not None, a.shape
 (True, (2,))
 """
 
@@ -46,6 +49,7 @@ import math
 from typing import Any
 
 import numpy as np
+from gymnasium import spaces
 
 from digslam.agents.baselines import planning as pl
 from digslam.agents.baselines.policy import Memory, View
@@ -83,18 +87,15 @@ class DistanceAdvantageAgent(TourFrontierAgent):
 
     Args:
         advantage_weight: Weight of ``min_{s'} d(s', s)`` (path lengths, pixels); 1 is the paper's score,
-            0 gives the frontier agent exactly. 0.4 was the better of 0.4 and 1 on the validation levels
-            (24 levels per generator, 3000 steps; geometric mean of the frontier agent's time to the target
-            level over this agent's, weight 0.4 / weight 1: room 0.945 / 0.994, rocks 1.044 / 0.931, caves
-            1.023 / 1.000, rooms 0.941 / 0.920).
+            0 gives the frontier agent exactly.
         max_clusters, min_cluster: The candidates (:class:`~.tour.TourFrontierAgent`).
         **kw: :class:`~.frontier.FrontierAgent` arguments.
     """
 
     def __init__(
         self,
-        action_space: Any,
-        observation_space: Any = None,
+        action_space: spaces.Space,
+        observation_space: spaces.Space | None = None,
         seed: int | None = None,
         advantage_weight: float = 0.4,
         max_clusters: int = 8,

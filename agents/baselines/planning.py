@@ -9,6 +9,8 @@ runs on the ``m x m`` map in pixel coordinates ``(row, col)``:
   follow); :func:`path_lengths` from several pixels at once and :func:`pair_lengths` between them (compiled,
   :mod:`.planning_jit`: the same lengths bit for bit);
 * :func:`path_to`: the pixel path from the predecessor array (a loop over the path's pixels, not the grid);
+* :func:`erode`, :func:`dilate`: the masks grown or shrunk by whole pixels; :func:`pixel_centres`: the
+  pixels' centre coordinates;
 * :func:`line_of_sight`: the farthest path pixel reachable in a straight line over traversable pixels
   (string pulling, vectorised over the path and its samples);
 * :func:`turn_then_go`: the unicycle command. Turning while driving makes the observer's box wrap around the
@@ -23,6 +25,7 @@ runs on the ``m x m`` map in pixel coordinates ``(row, col)``:
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -163,6 +166,14 @@ def dilate(mask: np.ndarray, k: int = 1) -> np.ndarray:
     return pj.box_dilate(np.ascontiguousarray(mask, dtype=bool), int(k))
 
 
+@functools.lru_cache(maxsize=8)
+def pixel_centres(m: int) -> np.ndarray:
+    """``(2, m, m)`` read-only row and column coordinates of the pixel centres of an ``m x m`` map."""
+    out = np.mgrid[:m, :m] + 0.5
+    out.flags.writeable = False
+    return out
+
+
 def wrap(a: float) -> float:
     """Angle in ``(-π, π]``."""
     return (a + math.pi) % (2 * math.pi) - math.pi
@@ -196,7 +207,10 @@ __all__ = [
     "erode",
     "line_of_sight",
     "pair_lengths",
+    "path_lengths",
     "path_to",
+    "pixel_centres",
+    "pixel_graph",
     "shortest_paths",
     "turn_then_go",
     "wrap",

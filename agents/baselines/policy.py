@@ -2,13 +2,14 @@
 
 Every agent reads only the observation (no privileged ``info``): the ``"map"`` (clear / penumbra / dark /
 pose-box channels over the world frame, row 0 = largest ``y``) and the ``"state"`` (normalised pose box,
-``cos``/``sin`` of the mid heading, ``tanh`` of the tube width, ...), see
-:mod:`digslam.envs.dig_coverage.wrapper`. :meth:`BaselinePolicy.predict` takes one observation or a VecEnv
-batch and keeps one :class:`Memory` per environment index (renewed on ``episode_start`` or when the elapsed
-share is 0, i.e. right after ``reset``).
+``cos``/``sin`` of the mid heading, ``tanh`` of the tube width, ...), whose layout is the schema of
+:mod:`digslam.envs.observation` (:class:`~digslam.envs.observation.Channel`,
+:class:`~digslam.envs.observation.State`). :func:`parse` reads one observation into a :class:`View`;
+:meth:`BaselinePolicy.predict` takes one observation or a VecEnv batch and keeps one :class:`Memory` per
+environment index (renewed on ``episode_start`` or when the elapsed share is 0, i.e. right after ``reset``).
 
->>> state = np.zeros(11, np.float32); state[[4, 10]] = 1.0      # at the centre, heading +x, consistent
->>> img = np.zeros((4, 36, 36), np.uint8); img[0] = 255
+>>> state = np.zeros(N_STATE, np.float32); state[[State.COS, State.CONSISTENT]] = 1.0  # centre, heading +x
+>>> img = np.zeros((4, 36, 36), np.uint8); img[Channel.CLEAR] = 255
 >>> v = parse(img, state)
 >>> v.pos.tolist(), v.heading, bool(v.clear.all()), v.tube
 ([18.0, 18.0], 0.0, True, 0.0)
@@ -24,13 +25,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from gymnasium import spaces  # noqa: F401  (doctest)
+from gymnasium import spaces
 
 from digslam.agents.baselines import planning as pl
 from digslam.agents.baselines import policy_jit as pj
+from digslam.envs.observation import N_STATE, Channel, State
 
-#: Indices of the observation's ``"state"`` vector (:mod:`digslam.envs.dig_coverage.wrapper`).
-S_COS, S_SIN, S_TUBE, S_ELAPSED, S_CONSISTENT = 4, 5, 7, 8, 10
 _KNOWN_KW = {"span", "max_speed", "max_yaw_rate", "dt", "sensor_range"}
 
 
@@ -58,11 +58,12 @@ def parse(obs_map: np.ndarray, state: np.ndarray) -> View:
     img = np.asarray(obs_map) > 127
     m = img.shape[-1]
     s = np.asarray(state, dtype=np.float64)
-    ux, uy = 0.5 * (s[0] + s[2]), 0.5 * (s[1] + s[3])
+    ux, uy = 0.5 * (s[State.X_LO] + s[State.X_HI]), 0.5 * (s[State.Y_LO] + s[State.Y_HI])
     pos = np.array([(1.0 - uy) * 0.5 * m, (ux + 1.0) * 0.5 * m])
-    tube = math.atanh(min(max(float(s[S_TUBE]), 0.0), 1.0 - 1e-7))
-    heading = math.atan2(s[S_SIN], s[S_COS])
-    return View(img[0], img[1], img[2], pos, heading, tube, s[S_CONSISTENT] > 0.5, np.asarray(obs_map))
+    tube = math.atanh(min(max(float(s[State.TUBE]), 0.0), 1.0 - 1e-7))
+    heading = math.atan2(s[State.SIN], s[State.COS])
+    return View(img[Channel.CLEAR], img[Channel.PENUMBRA], img[Channel.DARK], pos, heading, tube,
+                bool(s[State.CONSISTENT] > 0.5), np.asarray(obs_map))  # fmt: skip
 
 
 @dataclass
@@ -103,7 +104,8 @@ class BaselinePolicy:
         sensor_range: Longest sensor range (m).
     """
 
-    def __init__(self, action_space: Any, observation_space: Any = None, seed: int | None = None, **kw: Any):
+    def __init__(self, action_space: spaces.Space, observation_space: spaces.Space | None = None,
+                 seed: int | None = None, **kw: Any) -> None:  # fmt: skip
         unknown = sorted(set(kw) - _KNOWN_KW)
         if unknown:
             raise ValueError(f"{type(self).__name__}: unknown keyword argument(s) {unknown}; known: "
@@ -136,26 +138,30 @@ class BaselinePolicy:
         episode_start: np.ndarray | None = None,
         deterministic: bool = True,
     ) -> tuple[np.ndarray, None]:
-        """Actions for one observation ``{"map": (C, m, m), "state": (11,)}`` or a batch of them."""
+        """Actions for one observation ``{"map": (C, m, m), "state": (N_STATE,)}`` or a batch of them."""
         if not isinstance(observation, dict) or "map" not in observation or "state" not in observation:
             raise ValueError("observation: expected a dict with 'map' and 'state'")
         maps, states = np.asarray(observation["map"]), np.asarray(observation["state"])
         single = states.ndim == 1
         if single:
             maps, states = maps[None], states[None]
-        if maps.ndim != 4 or states.shape[-1] < 11 or len(maps) != len(states):
+        if maps.ndim != 4 or states.shape[-1] < N_STATE or len(maps) != len(states):
             raise ValueError(f"observation: bad shapes map {maps.shape}, state {states.shape}")
         starts = np.zeros(len(states), bool) if episode_start is None else np.asarray(episode_start, bool)
         out = np.zeros((len(states), 2), dtype=np.float32)
         for i in range(len(states)):  # one planner call per environment of the batch
             view = parse(maps[i], states[i])
             mem = self._mem.get(i)
-            fresh = bool(starts.reshape(-1)[i]) or states[i, S_ELAPSED] <= 0
+            fresh = bool(starts.reshape(-1)[i]) or states[i, State.ELAPSED] <= 0
             if mem is None or mem.m != view.clear.shape[0] or fresh:
                 mem = self._mem[i] = Memory(view.clear.shape[0])
             out[i] = np.minimum(np.maximum(self._act(view, mem), -1.0), 1.0) if view.consistent else 0.0
             mem.t += 1
         return (out[0] if single else out), None
+
+    def memory(self, i: int = 0) -> Memory | None:
+        """Environment ``i``'s :class:`Memory` (None before its first step)."""
+        return self._mem.get(i)
 
     def _act(self, view: View, mem: Memory) -> np.ndarray:
         raise NotImplementedError

@@ -1,20 +1,22 @@
 """Heuristic coverage baselines for ``digslam/DigCoverage-v0`` with SB3's ``predict`` interface.
 
 * :class:`RandomAgent`: uniform actions;
-* :class:`LawnmowerAgent`: boustrophedon lanes over the world frame, reached through the grid planner;
+* :class:`LawnmowerAgent`: boustrophedon lanes over the world frame, reached through the grid planner
+  (:mod:`.lawnmower`);
 * :class:`FrontierAgent`: nearest frontier between clear and dark (then penumbra) ground, Dijkstra over
-  the clear pixels (:mod:`.planning`); it turns in place and drives straight, since the guaranteed
-  observer's box grows about 17 times faster along arcs than along straight lines;
+  the clear pixels (:mod:`.frontier`, on the loop of :mod:`.navigating` and the planner of :mod:`.planning`);
+  it turns in place and drives straight, since the guaranteed observer's box grows about 17 times faster
+  along arcs than along straight lines;
 * :class:`TourFrontierAgent`: the frontier agent whose goal starts the shortest open tour over the frontier
   clusters (a regret term on the clusters that would leave a detour behind, :mod:`.tour`);
 * :class:`DistanceAdvantageAgent`: the frontier agent whose goal is the frontier cluster close to the robot
   and far from the other clusters (distance advantage, Ericson et al. 2025, :mod:`.distance_advantage`);
 * :class:`UncertaintyAwareFrontier`: when the tube is wider than a threshold, goes back into clear ground
   near sensed obstacles, visited while the tube was narrow, and turns there until the tube shrinks (active
-  loop closure).
+  loop closure, :mod:`.uncertainty`).
 
 All read only the observation (:mod:`digslam.agents.baselines.policy`). :func:`make_baseline` sizes one
-from an env.
+from an env (:func:`sizing`: its observer layer, :func:`digslam.envs.stack.observer_of`).
 
 >>> import gymnasium as gym, digslam.envs
 >>> env = gym.make("digslam/DigCoverage-v0", map_size=36)
@@ -29,10 +31,15 @@ from __future__ import annotations
 
 from typing import Any
 
+import gymnasium as gym
+
 from digslam.agents.baselines.distance_advantage import DistanceAdvantageAgent
-from digslam.agents.baselines.frontier import FrontierAgent, LawnmowerAgent, UncertaintyAwareFrontier
+from digslam.agents.baselines.frontier import FrontierAgent
+from digslam.agents.baselines.lawnmower import LawnmowerAgent
 from digslam.agents.baselines.policy import BaselinePolicy, RandomAgent
 from digslam.agents.baselines.tour import TourFrontierAgent
+from digslam.agents.baselines.uncertainty import UncertaintyAwareFrontier
+from digslam.envs.stack import observer_of
 
 #: Baseline names and classes.
 BASELINES: dict[str, type[BaselinePolicy]] = {
@@ -45,19 +52,7 @@ BASELINES: dict[str, type[BaselinePolicy]] = {
 }
 
 
-def observer_layer(env: Any) -> Any:
-    """The ``GuaranteedObserver`` layer of a (wrapped) env, or None."""
-    e = env
-    for _ in range(32):
-        if hasattr(e, "grid") and hasattr(e, "filter"):
-            return e
-        if not hasattr(e, "env"):
-            break
-        e = e.env
-    return None
-
-
-def make_baseline(name: str, env: Any, seed: int | None = None) -> BaselinePolicy:
+def make_baseline(name: str, env: gym.Env, seed: int | None = None) -> BaselinePolicy:
     """The baseline ``name`` (a key of :data:`BASELINES`) sized from ``env`` (grid span, speeds, ranges).
 
     Raises:
@@ -68,23 +63,22 @@ def make_baseline(name: str, env: Any, seed: int | None = None) -> BaselinePolic
     return BASELINES[name](env.action_space, env.observation_space, seed=seed, **sizing(env))
 
 
-def sizing(env: Any) -> dict[str, Any]:
+def sizing(env: gym.Env) -> dict[str, Any]:
     """The :class:`BaselinePolicy` keywords that size an agent for ``env``: grid span, speeds, step and
     sensor range (none for an env without a ``GuaranteedObserver`` layer)."""
-    kw: dict[str, Any] = {}
-    layer = observer_layer(env)
-    if layer is not None:
-        g = layer.grid
-        raw = layer.env.unwrapped
-        kw.update(span=float(g.hi[0] - g.lo[0]), max_speed=raw.config.max_speed,
-                  max_yaw_rate=raw.config.max_yaw_rate, dt=raw.config.dt,
-                  sensor_range=float(raw.suite.r_max.max()))  # fmt: skip
-    return kw
+    try:
+        layer = observer_of(env)
+    except ValueError:  # not a certified-coverage env: the agents' defaults
+        return {}
+    g = layer.grid
+    raw: Any = layer.unwrapped  # the raw ExploreEnv (its robot and sensors), which this folder may not import
+    return {"span": float(g.hi[0] - g.lo[0]), "max_speed": raw.config.max_speed,
+            "max_yaw_rate": raw.config.max_yaw_rate, "dt": raw.config.dt,
+            "sensor_range": float(raw.suite.r_max.max())}  # fmt: skip
 
 
 __all__ = [
     "BASELINES",
-    "observer_layer",
     "sizing",
     "BaselinePolicy",
     "DistanceAdvantageAgent",

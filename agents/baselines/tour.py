@@ -1,11 +1,10 @@
 """Frontier exploration that plans a tour: the goal starts the shortest open tour over the frontier clusters.
 
-The greedy frontier agent (:class:`~.frontier.FrontierAgent`) takes the cheapest frontier pixel and often
-leaves a small frontier near the robot for a larger one farther on; the small one then costs a long trip back
-at the end. On the ``rooms`` generator this is what made the last room of a level wait for the end of the
-episode: a corridor stub next to the start room, skipped for the corridor on the other side, and reached
-some 750 steps later (validation level 1 000 001). Tour-based exploration planners (FUEL, Zhou et al. 2021,
-and before it the TSP ordering of frontier viewpoints) order the frontiers by a shortest tour instead.
+The greedy frontier agent (:class:`~.frontier.FrontierAgent`) takes the cheapest frontier pixel and may
+leave a small frontier near the robot for a larger one farther on; the small one then costs a long trip back
+at the end (on the ``rooms`` generator, a corridor stub next to the start room, skipped for the corridor on
+the other side). Tour-based exploration planners (FUEL, Zhou et al. 2021, and before it the TSP ordering of
+frontier viewpoints) order the frontiers by a shortest tour instead.
 
 :class:`TourFrontierAgent` keeps every cost of the frontier agent and adds a regret term: the frontier pixels
 next to dark ground are grouped into clusters (8-connected), the ``max_clusters`` cheapest clusters become
@@ -17,30 +16,19 @@ graph, each stopped once every stop is settled (:func:`.planning.pair_lengths`),
 leave a detour behind costs that detour. Clusters outside the tour, the other tiers and the hysteresis are
 those of the frontier agent. Everything comes from the observation, as for every baseline.
 
-Measured on the validation levels 1 000 000-1 000 011 of each generator (3000 steps, target 1.0; means over
-the 12 levels, frontier agent / tour frontier agent with ``tour_weight`` 2):
-
-=========  ===============  ===============  ===============  ===============
-generator  T80              T90              AUC              certified 0.9
-=========  ===============  ===============  ===============  ===============
-rooms      2555 / 2428      3000 / 2963      0.303 / 0.334    0 % / 8 %
-rocks      1096 / 1151      2297 / 2653      0.540 / 0.538    92 % / 58 %
-caves      365 / 369        665 / 710        0.767 / 0.768    100 % / 100 %
-=========  ===============  ===============  ===============  ===============
-
-The tour pays where frontiers are few and far apart (the rooms' corridors: the last room is less often left
-for the end) and costs where they are many and small (the gaps between rocks: ordering a dozen small
-clusters delays the last few per cent). ``tour_weight`` 1 gave rooms T80 2463 (AUC 0.322); ``min_cluster``
-6 was worse on rooms and rocks, and so was one stop for all clusters within the sensor range (5 m) of each
-other (rooms T80 2555, rocks 0.9 on 58 %). So it is a comparison row of the leaderboard, not the frontier
-agent's replacement.
+The tour pays where frontiers are few and far apart (corridors between rooms) and costs where they are many
+and small (the gaps between rocks: ordering a dozen small clusters delays the last few per cent); it is a
+comparison row of the leaderboard (``docs/benchmark.md``), not the frontier agent's replacement.
 
 >>> from gymnasium import spaces
+>>> from digslam.envs.observation import N_STATE, Channel, State
 >>> agent = TourFrontierAgent(spaces.Box(-1, 1, (2,)))
->>> state = np.zeros(11, np.float32); state[[4, 10]] = 1.0; state[8] = 0.1    # centre, heading +x
->>> img = np.zeros((4, 36, 36), np.uint8); img[0, 8:28, 8:28] = 255; img[2] = 255 - img[0]
+>>> state = np.zeros(N_STATE, np.float32); state[[State.COS, State.CONSISTENT]] = 1.0   # centre, heading +x
+>>> state[State.ELAPSED] = 0.1
+>>> img = np.zeros((4, 36, 36), np.uint8); img[Channel.CLEAR, 8:28, 8:28] = 255
+>>> img[Channel.DARK] = 255 - img[Channel.CLEAR]
 >>> a, _ = agent.predict({"map": img, "state": state})
->>> agent._mem[0].goal is not None, a.shape
+>>> agent.memory(0).goal is not None, a.shape
 (True, (2,))
 """
 
@@ -50,6 +38,7 @@ import math
 from typing import Any
 
 import numpy as np
+from gymnasium import spaces
 from scipy import ndimage
 
 from digslam.agents.baselines import planning as pl
@@ -80,8 +69,7 @@ class TourFrontierAgent(FrontierAgent):
     """The frontier agent with a tour-regret term over its frontier clusters (see the module docstring).
 
     Args:
-        tour_weight: Weight of the regret (path lengths, pixels); 0 gives the frontier agent exactly. 2 was
-            the better of 1 and 2 on the validation levels (the module docstring's table).
+        tour_weight: Weight of the regret (path lengths, pixels); 0 gives the frontier agent exactly.
         max_clusters: Stops of the tour: the cheapest frontier clusters, at most :data:`.tour_jit.MAX_STOPS`.
         min_cluster: Pixels a cluster needs to be a stop (a lone pixel next to dark ground is often a hole in
             the penumbra, not a way on).
@@ -90,8 +78,8 @@ class TourFrontierAgent(FrontierAgent):
 
     def __init__(
         self,
-        action_space: Any,
-        observation_space: Any = None,
+        action_space: spaces.Space,
+        observation_space: spaces.Space | None = None,
         seed: int | None = None,
         tour_weight: float = 2.0,
         max_clusters: int = 8,

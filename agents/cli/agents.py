@@ -14,10 +14,15 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from digslam.agents.cli.common import UserError, make_env
 from digslam.agents.learning import models
+
+if TYPE_CHECKING:  # the types; gymnasium is imported with the environments
+    import gymnasium as gym
+
+    from digslam.agents.common.policy import PolicyPredictor
 
 
 def agent_names() -> list[str]:
@@ -37,7 +42,7 @@ def model_env_kwargs(model: Path | None = None) -> dict[str, Any]:
         raise UserError(str(exc)) from None
 
 
-def load_ppo(path: Path, env: Any) -> Any:
+def load_ppo(path: Path, env: gym.Env) -> PolicyPredictor:
     """The saved PPO model at ``path``, checked against ``env``'s spaces (:class:`UserError` otherwise)."""
     try:
         return models.load_ppo(path, env, opt="--model")
@@ -45,7 +50,7 @@ def load_ppo(path: Path, env: Any) -> Any:
         raise UserError(str(exc)) from None
 
 
-def load_agent(name: str, env: Any, model: Path | None = None) -> Any:
+def load_agent(name: str, env: gym.Env, model: Path | None = None) -> PolicyPredictor:
     """A policy with SB3's ``predict``: ``"ppo"`` (a saved PPO model, default the shipped one; a goal-level
     model comes as a :class:`~digslam.agents.goals.GoalAgent`), ``"predictive_frontier"`` (on the map
     predictor ``model``, default the shipped one), ``"predictive_chooser"`` (the goal-level ``model`` that

@@ -69,7 +69,8 @@ class _NoSigint:
 def cmd_train(args: argparse.Namespace) -> int:
     """``digslam train``: PPO (or, for a ``kind = "map_predictor"`` file, the map predictor) from a config
     file plus ``key=value`` overrides."""
-    from digslam.agents.learning.train import TrainConfig, TrainingInterrupted, train
+    from digslam.agents.learning.train import TrainingInterrupted, train
+    from digslam.agents.learning.train_config import TrainConfig
 
     config, overrides = args.config, list(args.overrides)
     if config is not None and "=" in config and not Path(config).is_file():  # only overrides were given

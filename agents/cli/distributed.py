@@ -13,7 +13,6 @@ from collections.abc import Callable
 from typing import Any
 
 from digslam.agents.cli.common import require_ray
-from digslam.agents.evaluation import ray_eval
 
 
 def add_ray_options(parser: argparse.ArgumentParser) -> Callable[[argparse.Namespace], Any]:
@@ -24,7 +23,7 @@ def add_ray_options(parser: argparse.ArgumentParser) -> Callable[[argparse.Names
     ``EvalResult`` of :func:`~digslam.agents.evaluation.ray_eval.evaluate_ray` (a pool of long-lived actors,
     one per CPU, taking batches of episodes; the result is the sequential one): ``"ppo"`` is the ``--model``
     path (default the shipped policy, with the environment keywords of its sidecar), any other agent a
-    baseline name (:func:`~digslam.agents.evaluation.ray_eval.agent_specs`).
+    baseline name (:func:`~digslam.agents.evaluation.specs.agent_specs`).
     """
     parser.add_argument("--ray", action="store_true", help="run the episodes on Ray actors (batches)")
     parser.add_argument(
@@ -35,8 +34,10 @@ def add_ray_options(parser: argparse.ArgumentParser) -> Callable[[argparse.Names
     def handler(args: argparse.Namespace) -> Any:
         if (args.address is not None or args.ray_cpus is not None) and not args.ray:
             raise ValueError("--address/--ray-cpus: only with --ray")
-        specs, kwargs = ray_eval.agent_specs(args.agents, args.model)
-        return ray_eval.evaluate_ray(specs, env_id=args.env, n_maps=args.maps, seed=args.seed,
+        from digslam.agents.evaluation import ray_eval, specs  # on use: the command line starts light
+
+        named, kwargs = specs.agent_specs(args.agents, args.model)
+        return ray_eval.evaluate_ray(named, env_id=args.env, n_maps=args.maps, seed=args.seed,
                                      steps=args.steps, env_kwargs=kwargs, address=args.address,
                                      num_cpus=args.ray_cpus)  # fmt: skip
 

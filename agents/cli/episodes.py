@@ -129,7 +129,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
         grid = Grid((-s, -s), (s, s), (args.grid, args.grid))
         start = ep.truth.pose[0, :2]
         res = dig_slam(ep.records, grid, start, start, DigSlamConfig(max_iter=args.max_iter))
-        if not res.consistent:
+        if not res.consistent or res.tube is None:
             print(f"dig_slam: inconsistent at gate {res.first_empty}")
         else:
             w = res.tube.widths()

@@ -42,27 +42,14 @@ def _robot() -> None:
 
 def _observer() -> None:
     import gymnasium as gym
+    import numpy as np
 
     import digslam.envs  # noqa: F401
     from digslam.agents.learning.models import DEFAULT_ENV, model_env_kwargs
 
     env = gym.make(DEFAULT_ENV, **model_env_kwargs())
     env.reset(seed=0)
-    layer = env
-    while not hasattr(layer, "filter"):
-        layer = layer.env
-    raw = layer.env.unwrapped
-    try:  # one more record at rest: the filter's kernels without the robot's (compiled by ``robot``)
-        raw.t += raw.config.dt
-        rec, _ = raw._sense(0)
-        layer.filter.update(rec)
-        layer.steps += 1
-        layer.observation()
-    except Exception:  # noqa: BLE001 - internals moved: a plain step compiles the same kernels
-        import numpy as np
-
-        env.reset(seed=0)
-        env.step(np.zeros(2, np.float32))
+    env.step(np.zeros(2, np.float32))  # a step at rest: the filter's and the observation's kernels
 
 
 def _interval() -> None:
@@ -102,7 +89,8 @@ def warmup(jobs: int | None = None, verbose: bool = False, names: tuple[str, ...
     """Run the jobs ``names`` (default :data:`JOBS`), ``jobs`` processes at a time (default: the CPU count,
     at most 3); 0 if all passed."""
     n = max(1, min(jobs or os.cpu_count() or 1, 3, len(names)))
-    start, todo, running, failed = time.perf_counter(), list(names), {}, []
+    start, todo, failed = time.perf_counter(), list(names), []
+    running: dict[str, tuple[subprocess.Popen[str], float]] = {}
     while todo or running:
         while todo and len(running) < n:
             name = todo.pop(0)

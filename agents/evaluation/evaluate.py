@@ -7,9 +7,9 @@ world regenerated at each reset, ``fixed_world=False``) and records, after each 
 the start, :func:`digslam.envs.dig_coverage.wrapper.reachable_free`), so certified <= ground truth; padded
 with the last value once the episode ends; plus the collisions (``info["bumps"]``), the final tube
 width (widest side of the pose box, m) and the true path length (m). :meth:`EvalResult.metrics` turns them
-into the benchmark metrics of :mod:`.metrics` (T80 / T90 / T95, AUC, ...). Policies are objects with
-``predict(obs, state=None, episode_start=None, deterministic=True)``: the baselines of :mod:`.baselines` or
-stable-baselines3 models.
+into the benchmark metrics of :mod:`.metrics` (T80 / T90 / T95, AUC, ...). Policies are
+:class:`~digslam.agents.common.policy.PolicyPredictor` objects (SB3's ``predict``): the baselines of
+:mod:`digslam.agents.baselines`, the goal agent or stable-baselines3 models.
 
 >>> r = EvalResult(curves={"a": np.array([[0.1, 0.2, 0.3]])}, true_curves={"a": np.array([[0.1, 0.3, 0.4]])},
 ...                collisions={"a": np.array([0])}, final_tube_width={"a": np.array([0.05])})
@@ -24,11 +24,15 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from digslam.agents.common.policy import PolicyFactory, PolicyPredictor, reset_policy
 from digslam.agents.evaluation.metrics import episodes_metrics, path_length
+
+if TYPE_CHECKING:  # gymnasium is imported with the environments, on use
+    import gymnasium as gym
 
 #: Environment keyword arguments that :func:`evaluate` sets unless ``env_kwargs`` does.
 EVAL_DEFAULTS: dict[str, Any] = {"fixed_world": False}
@@ -153,7 +157,9 @@ class EvalResult:
             raise ValueError(f"path: {path} is not an EvalResult JSON (missing {exc})") from None
 
 
-def make_env(env_id: str, steps: int, env_kwargs: dict[str, Any] | None, render: bool = False) -> Any:
+def make_env(env_id: str, steps: int, env_kwargs: dict[str, Any] | None, render: bool = False) -> gym.Env:
+    """The env of an evaluation: ``gym.make(env_id)`` with :data:`EVAL_DEFAULTS`, ``max_episode_steps=steps``
+    and ``env_kwargs`` (``render_mode="rgb_array"`` with ``render``)."""
     import gymnasium as gym
 
     import digslam.envs  # noqa: F401  (registers the environments)
@@ -165,12 +171,11 @@ def make_env(env_id: str, steps: int, env_kwargs: dict[str, Any] | None, render:
 
 
 def run_episode(
-    policy: Any, env: Any, seed: int, steps: int
+    policy: PolicyPredictor, env: gym.Env, seed: int, steps: int
 ) -> tuple[np.ndarray, np.ndarray, int, float, int, float]:
     """One episode: certified and true coverage after each step (padded), bumps, final tube width, length,
     true path length (m)."""
-    if hasattr(policy, "reset") and callable(policy.reset) and not hasattr(policy, "policy"):
-        policy.reset()  # a baseline (an SB3 model has .policy and no per-episode state)
+    reset_policy(policy)
     obs, info = env.reset(seed=seed)
     cert, true = np.empty(steps + 1), np.empty(steps + 1)
     cert[0], true[0] = info["certified_coverage"], info["true_coverage"]
@@ -192,7 +197,7 @@ def run_episode(
 
 
 def evaluate(
-    policies: dict[str, Any],
+    policies: dict[str, PolicyPredictor | PolicyFactory],
     env_id: str = "digslam/DigCoverage-v0",
     n_maps: int = 20,
     seed: int = 1000,
@@ -225,12 +230,11 @@ def evaluate(
     out: dict[str, dict[str, np.ndarray]] = {k: {} for k in "ctbwnp"}
     for name, policy in policies.items():
         env = make_env(env_id, steps, env_kwargs)
-        if not callable(getattr(policy, "predict", None)):
-            policy = policy(env)  # a factory: an agent built on the env it plays (the oracle diagnosis)
+        agent = policy if isinstance(policy, PolicyPredictor) else policy(env)  # a factory: built on its env
         try:
             rows = []
             for i in range(n_maps):
-                rows.append(run_episode(policy, env, seed + i, steps))
+                rows.append(run_episode(agent, env, seed + i, steps))
                 if bar is not None:
                     bar.set_postfix(agent=name, coverage=f"{rows[-1][0][-1]:.3f}")
                     bar.update()

@@ -15,13 +15,17 @@ Frames are drawn straight into a fixed palette (no colour quantization), so writ
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from digslam.agents.evaluation import overlays as ov
 from digslam.envs.dig_coverage.env import RGB
 from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
+
+if TYPE_CHECKING:  # the layer's and the raw env's types
+    from digslam.envs.dig_coverage.wrapper import GuaranteedObserver
+    from digslam.envs.explore.env import ExploreEnv
 
 MAP_SIZE = 512
 #: The panel: the read-out and legend column (``LEGEND_WIDTH`` px), then the inset's column.
@@ -87,9 +91,8 @@ class FrameDrawer:
     and draws the frame.
     """
 
-    def __init__(
-        self, layer: Any, title: str, target: float | None, steps: int, prediction: bool = False
-    ) -> None:
+    def __init__(self, layer: GuaranteedObserver, title: str, target: float | None, steps: int,
+                 prediction: bool = False) -> None:  # fmt: skip
         from PIL import Image, ImageDraw
 
         from digslam.envs.sim.raster import FREE, rasterize
@@ -127,10 +130,10 @@ class FrameDrawer:
         x0 = LEGEND_WIDTH
         d.line((x0, 8, x0, MAP_SIZE - 8), fill=INDEX["bar"], width=1)
         d.text((x0 + 12, 10), "the pose box, magnified", fill=INDEX["ink"], font=self.small)
-        words = ("white: the pose box, at its true", "size; green dot: the true",
+        notes = ("white: the pose box, at its true", "size; green dot: the true",
                  "position (ground truth, hidden", "from the robot), always inside.",
                  "blue: the estimated path.")  # fmt: skip
-        for k, line in enumerate(words):
+        for k, line in enumerate(notes):
             d.text(
                 (x0 + 12, INSET_AT[1] + INSET_SIZE + 56 + 16 * k), line, fill=INDEX["ink"], font=self.small
             )
@@ -169,13 +172,20 @@ class FrameDrawer:
         else:
             self.trail.clear()
 
+    @property
+    def raw(self) -> ExploreEnv:
+        """The raw env under the observer: the world and the robot that the frame draws (ground truth)."""
+        return cast("ExploreEnv", self.layer.unwrapped)
+
     def _cells(self, info: dict[str, Any]) -> np.ndarray:
-        raw = self.layer.env.unwrapped
-        if raw.world is not self._world:
+        world = self.raw.world
+        if world is None:
+            raise ValueError("env: no world yet; reset the env before drawing a frame")
+        if world is not self._world:
             rasterize, free = self._raster
             res = (self.hi[0] - self.lo[0]) / self.nx
-            cells = rasterize(raw.world.edges, (*self.lo, *self.hi), res)[::-1][: self.ny, : self.nx]
-            self._obstacles, self._world = cells != free, raw.world
+            cells = rasterize(world.edges, (*self.lo, *self.hi), res)[::-1][: self.ny, : self.nx]
+            self._obstacles, self._world = cells != free, world
         sets = info if "explored" in info else self.layer.sets()  # info_sets: the info's copies
         explored, clear = np.asarray(sets["explored"]), np.asarray(sets["clear"], bool)
         idx = np.full((self.ny, self.nx), INDEX["penumbra"], np.uint8)
@@ -212,12 +222,12 @@ class FrameDrawer:
                 continue
             r = 0.5 * float(rec.range[k][0] + rec.range[k][1]) * self.px
             a, g = th + float(rec.alpha[k]), float(rec.gamma[k])
-            box = (cx - r, cy - r, cx + r, cy + r)
+            circle = (cx - r, cy - r, cx + r, cy + r)
             if g >= math.pi - 1e-9:
-                d.ellipse(box, outline=INDEX["echo"], width=2)
+                d.ellipse(circle, outline=INDEX["echo"], width=2)
             else:  # PIL's angles go clockwise from +x in image coordinates (y down)
-                d.arc(box, math.degrees(-a - g), math.degrees(-a + g), fill=INDEX["echo"], width=3)
-        rad = max(self.layer.env.unwrapped.config.robot_radius * self.px, 4.0)
+                d.arc(circle, math.degrees(-a - g), math.degrees(-a + g), fill=INDEX["echo"], width=3)
+        rad = max(self.raw.config.robot_radius * self.px, 4.0)
         d.ellipse((cx - rad, cy - rad, cx + rad, cy + rad), fill=INDEX["robot"], outline=ink)
         d.line((cx, cy, cx + 2 * rad * math.cos(th), cy - 2 * rad * math.sin(th)), fill=ink, width=2)
         box = np.asarray(info["pose_box"], np.float64)
@@ -231,10 +241,9 @@ class FrameDrawer:
         img.paste(self._inset(idx, box if ok else None, (x, y, th)), (ix, iy))
         if ok:
             side = ov.inset_window(float(np.max(box[1] - box[0])))
-            k = INSET_SIZE / side  # pixels per metre in the inset
-            ov.scale_bar(
-                img, d, (ix, iy + INSET_SIZE + 30), k, INSET_SIZE / 2.5, (ink, paper), self.small, self.write
-            )
+            per_metre = INSET_SIZE / side  # pixels per metre in the inset
+            ov.scale_bar(img, d, (ix, iy + INSET_SIZE + 30), per_metre, INSET_SIZE / 2.5, (ink, paper),
+                         self.small, self.write)  # fmt: skip
         return img
 
     def _predicted(self, idx: np.ndarray, p: np.ndarray) -> None:

@@ -92,7 +92,7 @@ def episodes_metrics(
     c = np.atleast_2d(np.asarray(curves, dtype=np.float64))
     rows = []
     for i in range(c.shape[0]):
-        extra = {k: float(np.asarray(v, dtype=np.float64)[i]) for k, v in per_episode.items()}
+        extra: dict[str, Any] = {k: float(np.asarray(v, dtype=np.float64)[i]) for k, v in per_episode.items()}
         rows.append(episode_metrics(c[i], budget, **extra))
     return {k: np.array([r[k] for r in rows]) for k in rows[0]} if rows else {}
 

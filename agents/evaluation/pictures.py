@@ -8,11 +8,13 @@ only writes the GIF.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from digslam.agents.common.policy import PolicyPredictor, reset_policy
 from digslam.agents.evaluation.evaluate import EvalResult, make_env
 from digslam.agents.evaluation.frames import (
     INDEX,
@@ -28,19 +30,14 @@ from digslam.agents.evaluation.frames import (
     FrameDrawer,
     flat_palette,
 )
+from digslam.envs.stack import observer_of
 
-
-def _observer_layer(env: Any) -> Any:
-    e = env
-    while e is not None and not hasattr(e, "filter"):
-        e = getattr(e, "env", None)
-    if e is None:
-        raise ValueError("env: not a certified-coverage environment (no GuaranteedObserver inside)")
-    return e
+if TYPE_CHECKING:  # Pillow is imported on use only
+    from PIL import Image
 
 
 def demo_episode(
-    policy: Any,
+    policy: PolicyPredictor,
     env_id: str = "digslam/DigCoverage-v0",
     path: str | Path = "episode.gif",
     steps: int = 600,
@@ -50,7 +47,7 @@ def demo_episode(
     stride: int = 2,
     name: str = "agent",
     scale: int = 1,
-) -> Any:
+) -> EvalResult:
     """Run one episode of ``policy``, write its GIF to ``path`` (every ``stride``-th step and the last, each
     frame shrunk ``scale`` times) and return its :class:`~digslam.agents.evaluation.evaluate.EvalResult` (one
     episode; its curves end at the episode's last step, ``lengths`` the steps run, so ``n_steps`` is that
@@ -59,16 +56,15 @@ def demo_episode(
         if not (isinstance(v, int) and v >= 1):
             raise ValueError(f"{key}: must be an integer >= 1, got {v!r}")
     env = make_env(env_id, steps, env_kwargs)
-    if hasattr(policy, "reset") and callable(policy.reset) and not hasattr(policy, "policy"):
-        policy.reset()
+    reset_policy(policy)
     cert, true = np.empty(steps + 1), np.empty(steps + 1)
     try:
         obs, info = env.reset(seed=seed)
         title = f"{env_id.split('/')[-1]}: {name}"
-        shown = getattr(policy, "shown_prediction", None)  # an agent that predicts the map shows its guess
-        predicts = callable(shown)
-        shown = shown if predicts else (lambda: None)
-        drawer = FrameDrawer(_observer_layer(env), title, info.get("target"), steps, prediction=predicts)
+        guess = getattr(policy, "shown_prediction", None)  # an agent that predicts the map shows its guess
+        predicts = callable(guess)
+        shown: Callable[[], np.ndarray | None] = guess if callable(guess) else (lambda: None)
+        drawer = FrameDrawer(observer_of(env), title, info.get("target"), steps, prediction=predicts)
         frames = [drawer.frame(info, 0)]
         cert[0], true[0] = info["certified_coverage"], info["true_coverage"]
         state, start, n = None, np.ones(1, dtype=bool), 0
@@ -100,7 +96,7 @@ def demo_episode(
                       {name: np.array([tube])}, {name: np.array([float(n)])}, env_id, seed, 1)  # fmt: skip
 
 
-def write_gif(frames: list[Any], path: str | Path, fps: int) -> Path:
+def write_gif(frames: list[Image.Image], path: str | Path, fps: int) -> Path:
     """Write ``P``-mode frames sharing :data:`PALETTE` as a looping GIF."""
     pal = flat_palette()
     for f in frames:
@@ -112,7 +108,7 @@ def write_gif(frames: list[Any], path: str | Path, fps: int) -> Path:
 
 
 def record_episode_gif(
-    policy: Any,
+    policy: PolicyPredictor,
     env_id: str = "digslam/DigCoverage-v0",
     path: str | Path = "episode.gif",
     steps: int = 300,

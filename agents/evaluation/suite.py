@@ -1,6 +1,7 @@
 """The coverage benchmark suite: every generator, the test levels, an uncapped metric and a leaderboard.
 
-:func:`run_suite` runs every agent on ``n_maps`` levels of each generator of :data:`GENERATORS` (the first
+:func:`run_suite` runs every agent on ``n_maps`` levels of each generator of :data:`GENERATORS` (the
+benchmark's generators of the world registry, :data:`digslam.envs.sim.generators.BENCHMARK`; the first
 ``n_maps`` seeds of a split of :mod:`digslam.envs.splits`, the test split by default; the same levels for
 every agent), each episode with ``target=1.0`` (no early end: the curve is not capped) and a step budget of
 ``steps`` (3000). :class:`SuiteResult` turns the curves into the metrics of :mod:`.metrics` per generator
@@ -30,16 +31,19 @@ from typing import Any
 
 import numpy as np
 
+from digslam.agents.common.policy import PolicyFactory, PolicyPredictor, reset_policy
 from digslam.agents.evaluation.evaluate import EvalResult, evaluate
 from digslam.agents.evaluation.levels import TARGET_LEVELS, level_metric
 from digslam.agents.evaluation.metrics import paired_bootstrap_geomean
+from digslam.envs.config import ExploreConfig
+from digslam.envs.sim.generators import BENCHMARK
 
-#: Generator name -> (environment id, keywords): the suite's worlds.
+#: The environment id every suite episode runs on (the world is a keyword).
+SUITE_ENV = "digslam/DigCoverage-v0"
+#: Generator name -> (environment id, keywords): the suite's worlds, those of
+#: :data:`~digslam.envs.sim.generators.BENCHMARK` in its order (the default world needs no keyword).
 GENERATORS: dict[str, tuple[str, dict[str, Any]]] = {
-    "room": ("digslam/DigCoverage-v0", {}),
-    "rocks": ("digslam/DigCoverage-v0", {"world": "rocks"}),
-    "caves": ("digslam/DigCoverage-v0", {"world": "caves"}),
-    "rooms": ("digslam/DigCoverage-v0", {"world": "rooms"}),
+    name: (SUITE_ENV, {} if name == ExploreConfig.world else {"world": name}) for name in BENCHMARK
 }
 #: What every suite episode runs with: no early end, so the metric is not capped at 0.8.
 SUITE_KWARGS: dict[str, Any] = {"target": 1.0}
@@ -245,7 +249,7 @@ def merge(parts: Sequence[SuiteResult]) -> SuiteResult:
 
 
 def run_suite(
-    policies: Mapping[str, Any],
+    policies: Mapping[str, PolicyPredictor | PolicyFactory],
     n_maps: int = 30,
     steps: int = 3000,
     split: str = "test",
@@ -298,7 +302,7 @@ def suite_plan(
     for g in generators:
         env_id, kw = GENERATORS[g]
         plain = [a for a in agents if a not in extra]
-        groups = [(plain, {})] if plain else []
+        groups: list[tuple[list[str], dict[str, Any]]] = [(plain, {})] if plain else []
         groups += [([a], extra[a]) for a in extra if a in agents]
         plan += [(g, env_id, {**kw, **SUITE_KWARGS, **more}, group) for group, more in groups]
     return plan
@@ -316,7 +320,7 @@ def merge_agents(parts: Sequence[EvalResult]) -> EvalResult:
     return out
 
 
-def steps_per_second(policy: Any, env_id: str = "digslam/DigCoverage-v0", steps: int = 2000, seed: int = 0,
+def steps_per_second(policy: PolicyPredictor, env_id: str = SUITE_ENV, steps: int = 2000, seed: int = 0,
                      env_kwargs: Mapping[str, Any] | None = None) -> float:  # fmt: skip
     """Observed environment steps per second of ``policy`` driving one environment in this process (the
     policy's own time included), resetting to the next level whenever an episode ends; timed after one
@@ -324,7 +328,7 @@ def steps_per_second(policy: Any, env_id: str = "digslam/DigCoverage-v0", steps:
     return eval_rates(policy, env_id, steps, seed, env_kwargs)[0]
 
 
-def eval_rates(policy: Any, env_id: str = "digslam/DigCoverage-v0", steps: int = 2000, seed: int = 0,
+def eval_rates(policy: PolicyPredictor, env_id: str = SUITE_ENV, steps: int = 2000, seed: int = 0,
                env_kwargs: Mapping[str, Any] | None = None) -> tuple[float, float]:  # fmt: skip
     """``(eval steps/s, observed env steps/s)`` of one run of ``policy`` (see :func:`steps_per_second`): the
     first counts the agent's ``predict`` and the env's ``step`` (resets included), the second the env's
@@ -337,8 +341,7 @@ def eval_rates(policy: Any, env_id: str = "digslam/DigCoverage-v0", steps: int =
     env = make_env(env_id, steps + 1, {**SUITE_KWARGS, **dict(env_kwargs or {})})
     clock = time.perf_counter
     try:
-        if hasattr(policy, "reset") and callable(policy.reset) and not hasattr(policy, "policy"):
-            policy.reset()
+        reset_policy(policy)
         obs, _ = env.reset(seed=seed)
         obs = env.step(np.asarray(policy.predict(obs)[0], np.float32))[0]
         t_agent = t_env = 0.0
@@ -359,6 +362,7 @@ def eval_rates(policy: Any, env_id: str = "digslam/DigCoverage-v0", steps: int =
 
 __all__ = [
     "GENERATORS",
+    "SUITE_ENV",
     "SUITE_KWARGS",
     "SuiteResult",
     "check_generators",

@@ -11,7 +11,8 @@ gains), :mod:`.env` (``GoalSelectionEnv``, the semi-MDP wrapper), :mod:`.agent` 
 chooser, e.g. a trained ``MaskablePPO``, as a policy of the low-level env, step by step), :mod:`.policy`
 (``FirstCandidatePolicy``, ``RandomCandidatePolicy``) and :mod:`.registry` (the ids).
 
-May import: :mod:`digslam.envs`, :mod:`digslam.agents.baselines`; numpy, scipy, gymnasium.
+May import: :mod:`digslam.envs`, :mod:`digslam.agents.common` (the policy contract),
+:mod:`digslam.agents.baselines`; numpy, scipy, gymnasium.
 """
 
 from .agent import (

@@ -16,9 +16,8 @@ mask is ``goal_obs["mask"].astype(bool)``) or ``predict(goal_obs)`` (:class:`~.p
 returning a candidate index, or a tuple whose first item is one (SB3's ``(action, state)``).
 
 **Fidelity.** ``GoalAgent`` with :class:`~.policy.FirstCandidatePolicy` takes the same low-level actions as
-:class:`~digslam.agents.baselines.FrontierAgent` and as the goal env driven by that policy: identical
-certified-coverage curves over 1000 steps of the room, levels 1 000 000-1 000 001
-(``tests/agents/goals/test_agent.py``).
+:class:`~digslam.agents.baselines.FrontierAgent` and as the goal env driven by that policy (identical
+certified-coverage curves, checked by ``tests/agents/goals/test_agent.py``).
 
 Like the baselines it has ``reset`` and no ``policy`` attribute, so ``run_episode`` resets it before every
 episode; a VecEnv batch is handled per index (one macro-step state per environment of the batch).
@@ -27,17 +26,22 @@ episode; a VecEnv batch is handled per index (one macro-step state per environme
 from __future__ import annotations
 
 import inspect
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
+from gymnasium import spaces
 
-from digslam.agents.baselines.policy import S_ELAPSED, Memory
+from digslam.agents.baselines.policy import Memory
+from digslam.agents.common.policy import PolicyPredictor, reset_policy
 from digslam.agents.goals.candidates import Candidates
 from digslam.agents.goals.driver import KINDS, GoalDriver, driver_for
 from digslam.agents.goals.env import GoalSelectionEnv, decide, drive, ends, goal_space, start_goal
 from digslam.agents.goals.extra import n_extra
+from digslam.envs.observation import N_STATE, State
+from digslam.envs.stack import find_wrapper, observer_of
 
 _GOAL_PARAMS = inspect.signature(GoalSelectionEnv.__init__).parameters
 #: The keywords of :class:`~.env.GoalSelectionEnv` that are its own (the rest go to the base env), with their
@@ -111,7 +115,7 @@ class GoalAgent:
 
     def __init__(
         self,
-        chooser: Any,
+        chooser: PolicyPredictor,
         driver: GoalDriver,
         *,
         n_candidates: int = 16,
@@ -120,8 +124,8 @@ class GoalAgent:
         include_map: bool = False,
         candidate_features: str | None = None,
         deterministic: bool = True,
-        action_space: Any = None,
-        observation_space: Any = None,
+        action_space: spaces.Space | None = None,
+        observation_space: spaces.Space | None = None,
     ) -> None:
         if not callable(getattr(chooser, "predict", None)):
             raise ValueError(f"chooser: expected an object with predict(goal_obs), got {type(chooser)}")
@@ -144,7 +148,7 @@ class GoalAgent:
         self.reset()
 
     @classmethod
-    def from_env(cls, env: Any, chooser: Any, **kw: Any) -> GoalAgent:
+    def from_env(cls, env: gym.Env, chooser: PolicyPredictor, **kw: Any) -> GoalAgent:
         """A :class:`GoalAgent` whose driver is sized from the low-level ``env`` as
         :func:`~digslam.agents.baselines.registry.make_baseline` sizes the frontier agent.
 
@@ -156,7 +160,7 @@ class GoalAgent:
         Raises:
             ValueError: an unknown keyword, or ``env`` is a goal-selection env (give its base env).
         """
-        if isinstance(getattr(env, "unwrapped", None), GoalSelectionEnv):
+        if find_wrapper(env, GoalSelectionEnv) is not None:
             raise ValueError("env: give the low-level DigCoverage env the agent acts in, not the goal env")
         unknown = sorted(set(kw) - set(GOAL_KWARGS) - {"deterministic"})
         if unknown:
@@ -170,9 +174,10 @@ class GoalAgent:
                    action_space=env.action_space, observation_space=env.observation_space)  # fmt: skip
 
     @property
-    def goal_observation_space(self) -> Any:
+    def goal_observation_space(self) -> spaces.Dict:
         """The chooser's observation space (the goal env's), given the low-level observation space."""
-        map_space = self.observation_space["map"] if self.include_map and self.observation_space else None
+        low = self.observation_space
+        map_space = low["map"] if self.include_map and isinstance(low, spaces.Dict) else None
         if self.include_map and map_space is None:
             raise ValueError("goal_observation_space: include_map needs the low-level observation_space")
         return goal_space(self.n, map_space, self._n_more)
@@ -180,8 +185,7 @@ class GoalAgent:
     def reset(self) -> None:
         """Forget every environment's episode (and reset the chooser, if it has per-episode state)."""
         self._state: dict[int, MacroState] = {}
-        if callable(getattr(self.chooser, "reset", None)) and not hasattr(self.chooser, "policy"):
-            self.chooser.reset()
+        reset_policy(self.chooser)
 
     def state(self, i: int = 0) -> MacroState | None:
         """Environment ``i``'s :class:`MacroState` (None before its first step)."""
@@ -190,11 +194,11 @@ class GoalAgent:
     def predict(
         self,
         observation: dict[str, np.ndarray],
-        state: Any = None,
+        state: tuple[np.ndarray, ...] | None = None,
         episode_start: np.ndarray | None = None,
         deterministic: bool | None = None,
     ) -> tuple[np.ndarray, None]:
-        """The low-level action for one observation ``{"map": (C, m, m), "state": (11,)}`` (a ``(2,)``
+        """The low-level action for one observation ``{"map": (C, m, m), "state": (N_STATE,)}`` (a ``(2,)``
         float32 array), or for a VecEnv batch of them (``(n, 2)``, one macro-step state per index)."""
         if not isinstance(observation, dict) or "map" not in observation or "state" not in observation:
             raise ValueError("observation: expected a dict with 'map' and 'state' (the low-level env's)")
@@ -202,7 +206,7 @@ class GoalAgent:
         single = states.ndim == 1
         if single:
             maps, states = maps[None], states[None]
-        if maps.ndim != 4 or states.ndim != 2 or states.shape[-1] < 11 or len(maps) != len(states):
+        if maps.ndim != 4 or states.ndim != 2 or states.shape[-1] < N_STATE or len(maps) != len(states):
             raise ValueError(f"observation: bad shapes map {maps.shape}, state {states.shape}")
         starts = np.zeros(len(states), bool) if episode_start is None else np.asarray(episode_start, bool)
         starts = starts.reshape(-1)
@@ -216,7 +220,7 @@ class GoalAgent:
             obs = {"map": maps[i], "state": states[i]}
             s = self._state.get(i)
             m = maps.shape[-1]
-            if s is None or s.mem.m != m or bool(starts[i]) or states[i, S_ELAPSED] <= 0:
+            if s is None or s.mem.m != m or bool(starts[i]) or states[i, State.ELAPSED] <= 0:
                 s = self._state[i] = MacroState(self.driver.begin(m))
             out[i] = self._step(s, obs, det)
         return (out[0] if single else out), None
@@ -232,7 +236,7 @@ class GoalAgent:
                 kind, s.goal = start_goal(self.driver, s.mem, s.candidates, a)
                 s.kind, s.running, s.steps, s.decisions = KINDS[kind], True, 0, s.decisions + 1
             low, ev = drive(self.driver, obs, s.mem)
-            if ends(ev, s.steps, s.empty):
+            if ev is not None and ends(ev, s.steps, s.empty):
                 self._end(s, ev)
                 continue  # the next decision, on the same observation
             s.mem.t += 1
@@ -279,7 +283,7 @@ class GoalAgent:
         return out
 
 
-def _params(fn: Any) -> set[str]:
+def _params(fn: Callable[..., object]) -> set[str]:
     """Names of ``fn``'s parameters (``"**"`` when it takes any keyword)."""
     try:
         ps = inspect.signature(fn).parameters.values()
@@ -288,18 +292,14 @@ def _params(fn: Any) -> set[str]:
     return {"**" if p.kind is p.VAR_KEYWORD else p.name for p in ps}
 
 
-def _horizon(env: Any) -> int | None:
+def _horizon(env: gym.Env) -> int | None:
     """The ``horizon`` of a (wrapped) certified-coverage env's observer, which normalises the elapsed share
     of its ``"state"``; None if there is none."""
-    e = env
-    for _ in range(32):
-        cfg = getattr(e, "obs_config", None)
-        if cfg is not None and isinstance(getattr(cfg, "horizon", None), int):
-            return cfg.horizon
-        if not hasattr(e, "env"):
-            break
-        e = e.env
-    return None
+    try:
+        horizon = observer_of(env).obs_config.horizon
+    except ValueError:  # no GuaranteedObserver layer
+        return None
+    return horizon if isinstance(horizon, int) else None
 
 
 __all__ = [

@@ -126,7 +126,7 @@ def candidates(driver: GoalDriver, view: View, mem: Memory, n: int = 16) -> Cand
     reps = np.concatenate([f[0] for f in fr])
     order = np.lexsort((reps, cost.flat[reps]))
     f_rep, f_size = reps[order], np.concatenate([f[2] for f in fr])[order]
-    if keep_goal:  # the continuing goal stands for its cluster, first
+    if keep_goal and g is not None:  # the continuing goal stands for its cluster, first
         k = g[0] * m + g[1]
         lab = ndimage.label((tier == tier[g]) & np.isfinite(cost), structure=_EIGHT)[0]
         same = np.flatnonzero(lab.flat[f_rep] == lab[g]) if lab[g] else np.zeros(0, np.int64)
@@ -139,8 +139,9 @@ def candidates(driver: GoalDriver, view: View, mem: Memory, n: int = 16) -> Cand
     kind = np.full(n, -1, np.int64)
     goal = np.zeros((n, 2), np.int64)
     size = np.zeros(n)
-    rows = [(FRONTIER, f_rep[:nf], f_size[:nf]), (TURN, np.array([view.cell[0] * m + view.cell[1]]), [0]),
-            (CLOSURE, c_rep[:nc], c_size[:nc])]  # fmt: skip
+    rows: list[tuple[int, np.ndarray, np.ndarray]] = [
+        (FRONTIER, f_rep[:nf], f_size[:nf]), (TURN, np.array([view.cell[0] * m + view.cell[1]]), np.zeros(1)),
+        (CLOSURE, c_rep[:nc], c_size[:nc])]  # fmt: skip
     i = 0
     for kd, flat, sz in rows:
         j = i + len(flat)
@@ -184,11 +185,11 @@ def features(driver: GoalDriver, view: View, mem: Memory, plan: Plan, kind: np.n
         out[s, 4], out[s, 5] = math.tanh(path / span), math.tanh(heur / span)
         out[s, 6] = 1.0 if turn else bearing / math.pi
         out[s, 7], out[s, 8] = (0.0, 0.0) if turn else (dc * px / span, dr * px / span)
-        out[s, 9] = np.count_nonzero(view.dark & disc) / max(np.count_nonzero(disc), 1)
+        out[s, 9] = int(np.count_nonzero(view.dark & disc)) / max(int(np.count_nonzero(disc)), 1)
         out[s, 10] = math.tanh(float(mem.best_tube[r, c]))
         out[s, 11] = min(float(clearance[r, c]) / rng, 1.0)
         out[s, 12] = math.tanh(float(size[s]) / m)
-        out[s, 13] = s / max(n - 1, 1)
+        out[s, 13] = float(s) / max(n - 1, 1)
         out[s, 14] = float(keep[s])
     return np.clip(out, -1.0, 1.0)
 

@@ -1,6 +1,6 @@
 """The goal driver: the frontier agent's loop, driven towards one goal that the caller fixes.
 
-:class:`GoalDriver` is a :class:`~digslam.agents.baselines.frontier.UncertaintyAwareFrontier` (for its
+:class:`GoalDriver` is a :class:`~digslam.agents.baselines.uncertainty.UncertaintyAwareFrontier` (for its
 loop-closure targets) whose goal choice is replaced: ``NavigatingAgent._act`` still does the bookkeeping
 (visited pixels, the narrowest tube seen near each pixel), the reach check, the give-up budget, the re-plan
 every ``replan_every`` steps, the soft-planning Dijkstra of ``NavigatingAgent._plan`` and the turn-then-go
@@ -28,16 +28,12 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 
-from digslam.agents.baselines.frontier import (
-    KEEP_FACTOR,
-    KEEP_SLACK,
-    NavigatingAgent,
-    UncertaintyAwareFrontier,
-    keep_bound,
-)
+from digslam.agents.baselines.navigating import KEEP_FACTOR, KEEP_SLACK, NavigatingAgent, keep_bound
 from digslam.agents.baselines.policy import Memory, View
+from digslam.agents.baselines.uncertainty import UncertaintyAwareFrontier
 
 #: Candidate kinds.
 FRONTIER, CLOSURE, TURN = 0, 1, 2
@@ -190,7 +186,7 @@ class GoalDriver(UncertaintyAwareFrontier):
         return out
 
 
-def driver_for(env: Any, **kw: Any) -> GoalDriver:
+def driver_for(env: gym.Env, **kw: Any) -> GoalDriver:
     """A :class:`GoalDriver` sized from ``env`` as :func:`~digslam.agents.baselines.registry.make_baseline`
     sizes the frontier agent (grid span, speeds, step, sensor range), with ``kw`` on top."""
     from digslam.agents.baselines.registry import make_baseline

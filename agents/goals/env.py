@@ -13,8 +13,9 @@ over, or ``step_cap`` low-level steps.
 * observation: ``{"candidates": Box(-1, 1, (n, F)), "mask": MultiBinary(n), "global": Box(-1, 1, (G,))}``
   (+ ``"map"``, the base map, with ``include_map``): the features of :data:`.candidates.FEATURES` (then
   those of the ``candidate_features`` entry point, :mod:`.extra`) and
-  :data:`GLOBALS` (the base ``"state"``, the observer's own certified share ``state[9]`` among them, never
-  ``info["certified_coverage"]`` or ``info["true_coverage"]``). A function of the base observations only;
+  :data:`GLOBALS` (the base ``"state"``, the observer's own certified share ``State.CERTIFIED`` among them,
+  never ``info["certified_coverage"]`` or ``info["true_coverage"]``). A function of the base observations
+  only;
 * reward: ``reward_scale`` x the base rewards summed over the macro step (certified area gained, m², minus
   the base env's bump penalty) ``- step_cost`` per low-level step ``+ target_bonus`` when a frontier or
   closure goal is reached;
@@ -25,19 +26,24 @@ over, or ``step_cap`` low-level steps.
 
 **Fidelity.** Candidate 0 is the frontier agent's own pick and the driver is its loop, so always taking
 candidate 0 (:class:`~.policy.FirstCandidatePolicy`) makes the same low-level actions as
-:class:`~digslam.agents.baselines.FrontierAgent` on the base env: identical actions and certified-coverage
-curves over 3000 steps on the validation levels 1 000 000-1 000 001 of every generator with the default
-cap, and 1 000 002-1 000 003 with a cap of 13 steps (``tests/agents/goals/test_fidelity.py``). A macro step
+:class:`~digslam.agents.baselines.FrontierAgent` on the base env (identical actions and certified-coverage
+curves, checked by ``tests/agents/goals/test_fidelity.py``). A macro step
 may end before any low-level step (a goal given up at once, a closure target reached at once): the next
 decision is then made on the same observation; after ``MAX_EMPTY`` of those in a row the next one takes its
 first step whatever happens.
 
 **Semi-MDP.** SB3 discounts per decision: ``gamma`` applies once per macro step, whatever its length. No
 discount inside a macro step is applied here; time is charged by ``step_cost`` instead (with
-``gamma`` near 1 the return is about the coverage gained minus ``step_cost`` times the steps taken). The
-default 0.02 m² per step is about a tenth of the frontier agent's mean gain over its first 1000 steps on
-the room (0.15-0.21 m² per step on levels 1 000 000-1 000 002).
-``info["steps"]`` gives the durations for a duration-aware discount (``gamma ** steps``).
+``gamma`` near 1 the return is about the coverage gained minus ``step_cost`` times the steps taken; the
+default, 0.02 m² per step, is about a tenth of the area the frontier agent certifies per step early in an
+episode). ``info["steps"]`` gives the durations for a duration-aware discount (``gamma ** steps``).
+
+**A wrapper.** ``GoalSelectionEnv`` is a ``gymnasium.Wrapper`` with spaces of its own: ``env.unwrapped`` is
+the raw env at the bottom of the stack, onto which ``gym.make`` writes the spec of the id it made;
+:func:`digslam.envs.stack.find_wrapper` finds this layer in a stack (``find_wrapper(env, GoalSelectionEnv)``).
+A goal id's entry point is this class, built with ``env=None`` (it makes its base env): its ``spec`` is then
+the goal id's, as ``gym.make`` wrote it onto ``env.unwrapped`` (``spec.make()`` builds the same env again);
+around a given env it is Gymnasium's wrapper spec.
 """
 
 from __future__ import annotations
@@ -48,15 +54,19 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
+from gymnasium.envs.registration import EnvSpec
 
 from digslam.agents.baselines.policy import Memory, parse
 from digslam.agents.goals.candidates import N_FEATURES, Candidates, candidates
 from digslam.agents.goals.driver import CLOSURE, FRONTIER, KINDS, TURN, GoalDriver, driver_for
 from digslam.agents.goals.extra import n_extra, with_extra
+from digslam.agents.goals.registry import ENTRY_POINT
+from digslam.envs.observation import N_STATE
 
-#: Global features: the base ``"state"`` (11), then these (all in ``[-1, 1]``).
-GLOBALS = ("state",) * 11 + ("elapsed", "frontier_clusters", "closure_clusters", "dark_share",
-                             "penumbra_share")  # fmt: skip
+#: Global features: the base ``"state"`` (its ``N_STATE`` entries, :class:`~digslam.envs.observation.State`),
+#: then these (all in ``[-1, 1]``).
+GLOBALS = ("state",) * N_STATE + ("elapsed", "frontier_clusters", "closure_clusters", "dark_share",
+                                  "penumbra_share")  # fmt: skip
 #: Consecutive macro steps of no low-level step allowed before the next one takes its step anyway.
 MAX_EMPTY = 2
 
@@ -106,10 +116,11 @@ class GoalSelectionEnv(gym.Wrapper):
                             ("max_steps", max_steps, 1)):  # fmt: skip
             if not (isinstance(v, int) and not isinstance(v, bool) and v >= lo):
                 raise ValueError(f"{name}: must be an integer >= {lo}, got {v!r}")
-        for name, v in (("step_cost", step_cost), ("target_bonus", target_bonus),
+        for name, x in (("step_cost", step_cost), ("target_bonus", target_bonus),
                         ("reward_scale", reward_scale)):  # fmt: skip
-            if not np.isfinite(v):
-                raise ValueError(f"{name}: must be finite, got {v!r}")
+            if not np.isfinite(x):
+                raise ValueError(f"{name}: must be finite, got {x!r}")
+        built_here = env is None
         if env is None:
             kw = {"horizon": max_steps, **base_kwargs}
             if render_mode is not None:
@@ -118,7 +129,7 @@ class GoalSelectionEnv(gym.Wrapper):
         elif base_kwargs or render_mode is not None:
             raise ValueError(f"base keywords {sorted(base_kwargs)} need env=None (the env is built here)")
         super().__init__(env)
-        self._goal_spec: Any = None
+        self._built_here = built_here
         self.n, self.step_cap, self.max_steps = n_candidates, step_cap, max_steps
         self.step_cost, self.target_bonus = float(step_cost), float(target_bonus)
         self.reward_scale = float(reward_scale)
@@ -127,26 +138,30 @@ class GoalSelectionEnv(gym.Wrapper):
         n_more = n_extra(candidate_features)
         self.driver = driver_for(env, replan_every=replan_every, **dict(driver_kwargs or {}))
         self.action_space = spaces.Discrete(self.n)
-        self.observation_space = goal_space(self.n, env.observation_space["map"] if include_map else None,
-                                            n_more)  # fmt: skip
+        base_space = env.observation_space
+        map_space = base_space["map"] if include_map and isinstance(base_space, spaces.Dict) else None
+        if include_map and map_space is None:
+            raise ValueError(f"include_map: the base env has no 'map' observation ({base_space})")
+        self.observation_space = goal_space(self.n, map_space, n_more)
         self._base_obs: dict[str, np.ndarray] | None = None
         self._info: dict[str, Any] = {}
         self._cands: Candidates | None = None
         self._t, self._empty = 0, 0
-        self.mem: Any = None  # the driver's memory of the episode (visited pixels, tube widths, goal)
+        #: The driver's memory of the episode (visited pixels, tube widths, goal); None before ``reset``.
+        self.mem: Memory | None = None
 
     # --- gymnasium API -------------------------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[dict, dict]:
         obs, info = self.env.reset(seed=seed, options=options)
         self._t, self._empty = 0, 0
-        self.mem = self.driver.begin(np.asarray(obs["map"]).shape[-1])
+        self.mem = mem = self.driver.begin(np.asarray(obs["map"]).shape[-1])
         self._info = info
-        return self._decide(obs), dict(info)
+        return self._decide(obs, mem), dict(info)
 
     def step(self, action: Any) -> tuple[dict, float, bool, bool, dict]:
-        if self._cands is None or self._base_obs is None:
+        if self._cands is None or self._base_obs is None or self.mem is None:
             raise RuntimeError("step: call reset first")
-        a = self._check(action)
+        a = self._check(action, self._cands)
         mem = self.mem
         kind, goal = start_goal(self.driver, mem, self._cands, a)
         obs, info = self._base_obs, self._info
@@ -154,7 +169,7 @@ class GoalSelectionEnv(gym.Wrapper):
         terminated = truncated = False
         while True:
             low, ev = drive(self.driver, obs, mem)
-            if ends(ev, steps, self._empty):
+            if ev is not None and ends(ev, steps, self._empty):
                 event = ev
                 break
             obs, r, terminated, truncated, info = self.env.step(low)
@@ -173,7 +188,7 @@ class GoalSelectionEnv(gym.Wrapper):
         reward = self.reward_scale * total - self.step_cost * steps + (self.target_bonus if reached else 0.0)
         info = {**info, "steps": steps, "elapsed": self._t, "event": event, "kind": KINDS[kind], "goal": goal,
                 "base_reward": total}  # fmt: skip
-        return self._decide(obs), float(reward), bool(terminated), bool(truncated), info
+        return self._decide(obs, mem), float(reward), bool(terminated), bool(truncated), info
 
     def action_masks(self) -> np.ndarray:
         """``(n_candidates,)`` bool: the valid actions of the current decision."""
@@ -181,29 +196,20 @@ class GoalSelectionEnv(gym.Wrapper):
             raise RuntimeError("action_masks: call reset first")
         return self._cands.mask.copy()
 
-    # --- an environment in its own right -----------------------------------------------------------------
     @property
-    def unwrapped(self) -> GoalSelectionEnv:  # type: ignore[override]
-        """This env: its spaces, steps and spec are its own (``gym.make`` sets its spec here); the
-        DigCoverage env it drives is :attr:`env`."""
-        return self
+    def spec(self) -> EnvSpec | None:  # type: ignore[override]  # Env's is writable, a wrapper's read-only
+        """The goal id's spec when that id made this env (this layer built its base env, and ``gym.make``
+        wrote the id's spec onto ``env.unwrapped``); otherwise Gymnasium's wrapper spec."""
+        raw = self.unwrapped.spec
+        if self._built_here and raw is not None and raw.entry_point in (ENTRY_POINT, GoalSelectionEnv):
+            return raw
+        return super().spec
 
+    # --- the decision's state ---------------------------------------------------------------------------
     @property
-    def spec(self) -> Any:  # type: ignore[override]
-        return self._goal_spec
-
-    @spec.setter
-    def spec(self, value: Any) -> None:
-        self._goal_spec = value
-
-    @property
-    def _np_random(self) -> Any:  # the base env's generator (gymnasium's checker reads it here)
-        return self.env.unwrapped.np_random
-
-    @_np_random.setter
-    def _np_random(self, value: Any) -> None:
-        if value is not None:
-            self.env.unwrapped.np_random = value
+    def elapsed(self) -> int:
+        """Low-level steps taken in the episode."""
+        return self._t
 
     @property
     def candidates(self) -> Candidates | None:
@@ -216,7 +222,7 @@ class GoalSelectionEnv(gym.Wrapper):
         return self._base_obs
 
     # --- pieces --------------------------------------------------------------------------------------------
-    def _check(self, action: Any) -> int:
+    def _check(self, action: Any, cands: Candidates) -> int:
         a = np.asarray(action)
         whole = np.issubdtype(a.dtype, np.integer) or (
             np.issubdtype(a.dtype, np.floating) and a.size == 1 and float(a.reshape(-1)[0]).is_integer()
@@ -226,15 +232,15 @@ class GoalSelectionEnv(gym.Wrapper):
         i = int(a.reshape(-1)[0])
         if not 0 <= i < self.n:
             raise ValueError(f"action: candidate {i} is out of range [0, {self.n})")
-        mask = self._cands.mask  # type: ignore[union-attr]
+        mask = cands.mask
         if not mask[i]:
             raise ValueError(f"action: candidate {i} is masked out (valid: {np.flatnonzero(mask).tolist()})")
         return i
 
-    def _decide(self, obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    def _decide(self, obs: dict[str, np.ndarray], mem: Memory) -> dict[str, np.ndarray]:
         """Candidates and observation of the decision on the base observation ``obs``."""
         self._base_obs = obs
-        self._cands, out = decide(self.driver, obs, self.mem, self.n, self._t, self.max_steps,
+        self._cands, out = decide(self.driver, obs, mem, self.n, self._t, self.max_steps,
                                   self.include_map, self.candidate_features)  # fmt: skip
         return out
 
@@ -263,7 +269,7 @@ def decide(driver: GoalDriver, obs: Mapping[str, np.ndarray], mem: Memory, n: in
     c = candidates(driver, view, mem, n)
     nf = float(n)
     extra = [t / max_steps, c.n_frontier / nf, c.n_closure / nf, view.dark.mean(), view.penumbra.mean()]
-    glob = np.concatenate([np.asarray(obs["state"], np.float32)[:11], np.asarray(extra, np.float32)])
+    glob = np.concatenate([np.asarray(obs["state"], np.float32)[:N_STATE], np.asarray(extra, np.float32)])
     out = {"candidates": with_extra(candidate_features, driver, view, c), "mask": c.mask.astype(np.int8),
            "global": np.clip(glob, -1.0, 1.0).astype(np.float32)}  # fmt: skip
     if include_map:

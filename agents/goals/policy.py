@@ -14,12 +14,18 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from gymnasium import spaces
 
 
 class FirstCandidatePolicy:
     """Candidate 0 at every decision (valid at every decision: a frontier cluster or the turn)."""
 
-    def __init__(self, action_space: Any = None, observation_space: Any = None, seed: int | None = None):
+    def __init__(
+        self,
+        action_space: spaces.Space | None = None,
+        observation_space: spaces.Space | None = None,
+        seed: int | None = None,
+    ) -> None:
         self.action_space, self.observation_space, self.seed = action_space, observation_space, seed
 
     def reset(self) -> None:
@@ -40,7 +46,12 @@ class FirstCandidatePolicy:
 class RandomCandidatePolicy(FirstCandidatePolicy):
     """A uniform random valid candidate (the ``"mask"``), from a generator seeded by ``seed``."""
 
-    def __init__(self, action_space: Any = None, observation_space: Any = None, seed: int | None = None):
+    def __init__(
+        self,
+        action_space: spaces.Space | None = None,
+        observation_space: spaces.Space | None = None,
+        seed: int | None = None,
+    ) -> None:
         super().__init__(action_space, observation_space, seed)
         self.reset()
 

@@ -9,9 +9,8 @@
   candidate 0 by ``margin`` to be picked. This is policy improvement by rollouts of the frontier agent.
 * ``"rollout_fresh_noise"``: the same, but each copy draws its own measurement and odometry noise (a fresh
   random stream, ``fresh_noise=True``) instead of the noise the episode will draw: its picks cannot ride
-  on a lucky draw to come, only on the world's layout. On 6 validation levels each of room, caves and
-  rocks (target 0.9; ``benchmarks/bench_teacher.py``) both beat the frontier agent by about the same (T90
-  speedup 1.156 and 1.176), so the look-ahead's gain is the layout behind the frontiers, not the noise.
+  on a lucky draw to come, only on the world's layout (``benchmarks/bench_teacher.py`` compares both
+  teachers with the frontier agent).
 
 **Ground truth.** The rollout teacher steps *copies of the simulator*: it sees the world and the noise to
 come, which no agent may. It exists only to label training decisions; the labels are candidate indices of
@@ -28,7 +27,11 @@ import copy
 from collections.abc import Callable, Iterable
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
+
+from digslam.agents.goals.env import GoalSelectionEnv
+from digslam.envs.stack import find_wrapper
 
 #: The teachers :func:`demonstrations` knows.
 TEACHERS = ("frontier", "rollout", "rollout_fresh_noise")
@@ -57,22 +60,24 @@ class RolloutTeacher:
         self.k, self.horizon, self.margin = k, horizon, float(margin)
         self.fresh_noise, self.seed, self._copies = bool(fresh_noise), seed, 0
 
-    def score(self, env: Any, action: int) -> float:
+    def score(self, env: gym.Env, action: int) -> float:
         """Certified coverage of a copy of ``env`` after ``action`` then candidate 0 for :attr:`horizon`
         low-level steps (plus ``1 + unused share`` when the copy reached the target)."""
         sim = copy.deepcopy(env)
-        goal = sim.unwrapped
+        goal = find_wrapper(sim, GoalSelectionEnv)
+        if goal is None:
+            raise ValueError(f"env: a goal-selection env (GoalSelectionEnv inside), got {type(env).__name__}")
         if self.fresh_noise:
             self._copies += 1
-            goal.np_random = np.random.default_rng((self.seed, self._copies))
-        t0 = goal._t
+            sim.unwrapped.np_random = np.random.default_rng((self.seed, self._copies))
+        t0 = goal.elapsed
         _, _, done, cut, info = sim.step(action)
-        while not (done or cut) and goal._t - t0 < self.horizon:
+        while not (done or cut) and goal.elapsed - t0 < self.horizon:
             _, _, done, cut, info = sim.step(0)
-        bonus = 1.0 + (self.horizon - (goal._t - t0)) / self.horizon if done else 0.0
+        bonus = 1.0 + (self.horizon - (goal.elapsed - t0)) / self.horizon if done else 0.0
         return float(info["certified_coverage"]) + bonus
 
-    def choose(self, env: Any, obs: dict[str, np.ndarray]) -> int:
+    def choose(self, env: gym.Env, obs: dict[str, np.ndarray]) -> int:
         """The pick at ``env``'s current decision (``obs`` its observation)."""
         valid = np.flatnonzero(np.asarray(obs["mask"]) > 0)[: self.k]
         if len(valid) < 2:
@@ -94,11 +99,14 @@ def teacher(name: str, **kwargs: Any) -> Callable[[Any, dict[str, np.ndarray]], 
     raise ValueError(f"teacher: must be one of {TEACHERS}, got {name!r}")
 
 
-Chooser = Callable[[Any, dict[str, np.ndarray]], int]
+#: A teacher: the pick at the goal env's current decision, from the env and its observation.
+Chooser = Callable[[gym.Env, dict[str, np.ndarray]], int]
+#: A learner's pick from the observation alone.
 Actor = Callable[[dict[str, np.ndarray]], int]
 
 
-def demonstrations(env: Any, choose: Chooser, seeds: Iterable[int], log: Callable[[str], None] | None = None,
+def demonstrations(env: gym.Env, choose: Chooser, seeds: Iterable[int],
+                   log: Callable[[str], None] | None = None,
                    act: Actor | None = None) -> dict[str, np.ndarray]:  # fmt: skip
     """Every decision of ``choose`` on the goal env ``env`` over the levels ``seeds``: ``obs_<key>`` for
     each observation key, ``mask`` (bool) and ``action`` (int64, ``choose``'s pick), one row a decision.

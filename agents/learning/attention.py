@@ -33,6 +33,7 @@ torch.Size([2, 4])
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import gymnasium as gym
@@ -43,17 +44,17 @@ from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
 
 
-def _check_space(space: Any) -> tuple[int, int, int]:
+def _check_space(space: gym.spaces.Space) -> tuple[int, int, int]:
     """``(n, F, G)`` of a goal-selection observation space, or ValueError in one line."""
     keys = {"candidates", "mask", "global"}
     if not isinstance(space, gym.spaces.Dict) or not keys <= set(space.spaces):
         raise ValueError(f"observation_space: need a Dict with {sorted(keys)} (the goal-selection env's), "
                          f"got {space!r}")  # fmt: skip
-    shape = space["candidates"].shape
-    if len(shape) != 2 or space["mask"].shape != (shape[0],) or len(space["global"].shape) != 1:
+    shape, mask, glob = (space[k].shape or () for k in ("candidates", "mask", "global"))
+    if len(shape) != 2 or mask != (shape[0],) or len(glob) != 1:
         raise ValueError(f"observation_space: 'candidates' must be (n, F), 'mask' (n,) and 'global' (G,), "
-                         f"got {shape}, {space['mask'].shape}, {space['global'].shape}")  # fmt: skip
-    return int(shape[0]), int(shape[1]), int(space["global"].shape[0])
+                         f"got {shape}, {mask}, {glob}")  # fmt: skip
+    return int(shape[0]), int(shape[1]), int(glob[0])
 
 
 def rank_prior(n: int, strength: float) -> torch.Tensor:
@@ -116,8 +117,9 @@ class CandidateAttentionPolicy(MaskableMultiInputActorCriticPolicy):
     :class:`CandidateScorer` (module docstring). ``heuristic_prior`` is the scorer's starting slot bias;
     ``d`` and ``heads`` go to the extractor. ``MaskablePPO.load`` rebuilds it from the saved keywords."""
 
-    def __init__(self, observation_space: Any, action_space: Any, lr_schedule: Any, *, d: int = 64,
-                 heads: int = 4, heuristic_prior: float = 0.0, **kwargs: Any) -> None:  # fmt: skip
+    def __init__(self, observation_space: gym.spaces.Dict, action_space: gym.spaces.Space,
+                 lr_schedule: Callable[[float], float], *, d: int = 64, heads: int = 4,
+                 heuristic_prior: float = 0.0, **kwargs: Any) -> None:  # fmt: skip
         if not np.isfinite(heuristic_prior) or heuristic_prior < 0:
             raise ValueError(f"heuristic_prior: must be finite and >= 0, got {heuristic_prior!r}")
         self.heuristic_prior = float(heuristic_prior)
@@ -126,19 +128,31 @@ class CandidateAttentionPolicy(MaskableMultiInputActorCriticPolicy):
         kwargs["features_extractor_kwargs"] = {"d": d, "heads": heads}
         super().__init__(observation_space, action_space, lr_schedule, **kwargs)
 
-    def _build(self, lr_schedule: Any) -> None:
-        super()._build(lr_schedule)
+    @property
+    def attention(self) -> CandidateAttentionExtractor:
+        """The features extractor (always a :class:`CandidateAttentionExtractor`)."""
         ext = self.features_extractor
+        if not isinstance(ext, CandidateAttentionExtractor):
+            raise TypeError(f"features_extractor: expected a CandidateAttentionExtractor, got {type(ext)}")
+        return ext
+
+    def _build(self, lr_schedule: Callable[[float], float]) -> None:
+        super()._build(lr_schedule)
+        ext = self.attention
         if self.mlp_extractor.latent_dim_pi != ext.features_dim:
             raise ValueError("net_arch: the actor must read the extractor's features as they are (pi=[])")
-        self.action_net = CandidateScorer(ext.n, ext.d, self.heuristic_prior)
-        nn.init.orthogonal_(self.action_net.score.weight, gain=0.01)
-        nn.init.zeros_(self.action_net.score.bias)
-        self.optimizer = self.optimizer_class(self.parameters(), lr=lr_schedule(1), **self.optimizer_kwargs)
+        scorer = CandidateScorer(ext.n, ext.d, self.heuristic_prior)
+        nn.init.orthogonal_(scorer.score.weight, gain=0.01)
+        nn.init.zeros_(scorer.score.bias)
+        self.action_net = scorer
+        # SB3 types optimizer_class as type[Optimizer], whose base takes no lr; its own _build passes lr too
+        self.optimizer = self.optimizer_class(  # type: ignore[call-arg]
+            self.parameters(), lr=lr_schedule(1), **self.optimizer_kwargs
+        )
 
     def _get_constructor_parameters(self) -> dict[str, Any]:
         data = super()._get_constructor_parameters()
-        ext = self.features_extractor
+        ext = self.attention
         data.update(d=ext.d, heads=ext.attn.num_heads, heuristic_prior=self.heuristic_prior)
         data.pop("features_extractor_class", None)
         data.pop("features_extractor_kwargs", None)

@@ -1,17 +1,16 @@
 """``MapStateExtractor``: an SB3 features extractor sized from the ``DigCoverage`` observation space.
 
 The observation of :class:`~digslam.envs.dig_coverage.wrapper.GuaranteedObserver` is a ``Dict`` with a
-``"map"`` image ``(C, m, m)`` (4 channels, or 7 with an egocentric crop) and an 11-vector ``"state"``.
+``"map"`` image ``(C, m, m)`` (4 channels, or 7 with an egocentric crop) and a ``"state"`` vector, laid out
+by :mod:`digslam.envs.observation` (:func:`~digslam.envs.observation.observation_space`).
 The image goes through stride-2 convolutions (as many as it takes to bring the side down to at most 8
 pixels, so any side from 36 upwards works), the state through a small MLP, and both are fused into
 ``features_dim`` features. SB3 has already scaled the ``uint8`` image to ``[0, 1]``.
 
->>> import numpy as np, torch
->>> from gymnasium import spaces
->>> space = spaces.Dict({"map": spaces.Box(0, 255, (7, 36, 36), np.uint8),
-...                      "state": spaces.Box(-1, 1, (11,), np.float32)})
->>> ext = MapStateExtractor(space, features_dim=64)
->>> ext({"map": torch.zeros(2, 7, 36, 36), "state": torch.zeros(2, 11)}).shape
+>>> import torch
+>>> from digslam.envs.observation import N_STATE, observation_space
+>>> ext = MapStateExtractor(observation_space(36, crop=True), features_dim=64)
+>>> ext({"map": torch.zeros(2, 7, 36, 36), "state": torch.zeros(2, N_STATE)}).shape
 torch.Size([2, 64])
 """
 
@@ -61,7 +60,7 @@ class MapStateExtractor(BaseFeaturesExtractor):
             raise ValueError(
                 f"observation_space: need a Dict with 'map' and 'state', got {observation_space!r}"
             )
-        shape = observation_space["map"].shape
+        shape = observation_space["map"].shape or ()
         if len(shape) != 3 or shape[1] != shape[2]:
             raise ValueError(f"observation_space: 'map' must have shape (C, m, m), got {shape}")
         if not isinstance(features_dim, int) or features_dim < 1:
@@ -78,7 +77,7 @@ class MapStateExtractor(BaseFeaturesExtractor):
         self.cnn = nn.Sequential(*layers)
         with torch.no_grad():
             n_flat = int(self.cnn(torch.zeros(1, c_in, side, side)).shape[1])
-        n_state = int(observation_space["state"].shape[0])
+        n_state = int((observation_space["state"].shape or (0,))[0])
         self.state_mlp = nn.Sequential(nn.Linear(n_state, state_dim), nn.ReLU())
         self.head = nn.Sequential(nn.Linear(n_flat + state_dim, features_dim), nn.ReLU())
 

@@ -4,8 +4,8 @@
 goal-level ``MaskablePPO`` (attention over the candidate goals, warm-started by imitation of a look-ahead
 teacher) that acts in :data:`DEFAULT_ENV` through the goal driver, with the environment keywords of its
 ``.json`` sidecar (:func:`model_env_kwargs`; every model saved by ``digslam train`` has one).
-:data:`LOWLEVEL` is the former shipped policy, a low-level PPO steering ``(v, ω)`` from the map, kept as a
-comparison row of the benchmark (``ppo_lowlevel``). :func:`load_ppo` reads a saved PPO ``.zip`` and
+:data:`LOWLEVEL` is a low-level PPO steering ``(v, ω)`` from the map, a comparison row of the benchmark
+(``ppo_lowlevel``). :func:`load_ppo` reads a saved PPO ``.zip`` and
 checks it against an environment's observation space. A model or sidecar that cannot be used raises
 :class:`ModelError` (a ``ValueError``) in one line that names the file and says what to do; the command line
 shows it as is.
@@ -16,7 +16,7 @@ not low-level actions: :func:`load_ppo` returns it inside a
 :class:`~digslam.agents.goals.GoalAgent`, a policy of the low-level env like any other, and
 :func:`model_env_kwargs` gives the keywords of the *low-level* env (the goal env's own keywords, such as
 ``n_candidates`` or ``step_cap``, go to the ``GoalAgent`` instead; the ``horizon`` is the goal env's
-``max_steps``). :mod:`digslam.agents.goals` is imported by its name (:func:`~.train.env_module`, as
+``max_steps``). :mod:`digslam.agents.goals` is imported by its name (:func:`~.vec_env.env_module`, as
 ``gym.make`` imports it for these ids), on use only.
 
 Torch, stable-baselines3 and sb3-contrib are imported only by :func:`load_ppo`.
@@ -33,7 +33,14 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # gymnasium, stable-baselines3 and the goal agent are imported on use only
+    import gymnasium as gym
+    from stable_baselines3.common.base_class import BaseAlgorithm
+
+    from digslam.agents.common.policy import PolicyPredictor
 
 #: The folder of the shipped model (and of its sidecar and README).
 DATA = Path(__file__).parents[1] / "data"
@@ -54,7 +61,7 @@ LEADERBOARD = DATA / "leaderboard.json"
 DEFAULT_ENV = "digslam/DigCoverage-v0"
 
 
-#: The package of the goal-selection envs (:func:`~.train.env_module` of their ids).
+#: The package of the goal-selection envs (:func:`~.vec_env.env_module` of their ids).
 GOALS = "digslam.agents.goals"
 #: Environment keywords of a training run that are no part of what the model sees (the levels it trained
 #: on among them: each command picks its own, the benchmark each generator of its suite; and the coverage
@@ -98,13 +105,13 @@ def model_meta(model: str | Path | None = None) -> dict[str, Any]:
 
 def goal_env_id(meta: dict[str, Any]) -> str | None:
     """The goal-selection env id a sidecar (:func:`model_meta`) names, or None (a low-level model)."""
-    from digslam.agents.learning.train import env_module
+    from digslam.agents.learning.vec_env import env_module
 
     env_id = meta.get("env_id")
     return env_id if isinstance(env_id, str) and env_module(env_id) == GOALS else None
 
 
-def _goals() -> Any:
+def _goals() -> ModuleType:
     """:mod:`digslam.agents.goals` (registers the goal ids), imported on use."""
     import digslam.agents.goals as goals
 
@@ -155,7 +162,7 @@ def model_env_kwargs(model: str | Path | None = None) -> dict[str, Any]:
     return kw
 
 
-def as_policy(model: Any) -> Any:
+def as_policy(model: BaseAlgorithm) -> PolicyPredictor:
     """``model`` as a policy of the continuous environment: a model trained on discrete turn-or-go actions
     (``actions = "turn_go"``) wrapped in :class:`~.wrappers.TurnGoPolicy`, any other as it is."""
     if getattr(model.action_space, "n", None) is None:
@@ -165,7 +172,7 @@ def as_policy(model: Any) -> Any:
     return TurnGoPolicy(model)
 
 
-def load_ppo(path: str | Path, env: Any, opt: str = "model") -> Any:
+def load_ppo(path: str | Path, env: gym.Env, opt: str = "model") -> PolicyPredictor:
     """The saved PPO model at ``path`` (on the CPU, torch on one thread), checked against ``env``'s
     observation space; a model trained on discrete turn-or-go actions (``actions = "turn_go"``) comes
     wrapped in :class:`~.wrappers.TurnGoPolicy`, so that it acts in the continuous environment; a goal-level
@@ -189,37 +196,44 @@ def load_ppo(path: str | Path, env: Any, opt: str = "model") -> Any:
                          f"(or leave {opt} out for the shipped policy)")  # fmt: skip
     meta = model_meta(path)
     goal_id = goal_env_id(meta)
+    algo: type[BaseAlgorithm]
     try:
         if goal_id is not None:
-            from sb3_contrib import MaskablePPO as PPO
+            from sb3_contrib import MaskablePPO
+
+            algo = MaskablePPO
         else:
             from stable_baselines3 import PPO
+
+            algo = PPO
     except ImportError:
         raise ModelError(f"{opt} needs stable-baselines3{', sb3-contrib' if goal_id else ''} and torch; "
                          'install the train extra: pip install "digslam[train]"') from None  # fmt: skip
-    from digslam.agents.learning.train import pin_threads
+    from digslam.agents.learning.vec_env import pin_threads
 
     pin_threads(1)
     kind = f"MaskablePPO model of {goal_id}" if goal_id else "PPO model"
     try:
-        model = PPO.load(path, device="cpu")
+        model = algo.load(path, device="cpu")
     except Exception as exc:  # noqa: BLE001 - any failure to read the file is the file's
         raise ModelError(f"{opt} {path}: not a {kind} saved by `digslam train` "
                          f"({type(exc).__name__}: {_first_line(exc)})") from None  # fmt: skip
     if goal_id is not None:
         return _goal_agent(model, path, env, meta, opt)
     try:
-        model = as_policy(model)
+        policy = as_policy(model)
     except ValueError as exc:
         raise ModelError(f"{opt} {path}: {_first_line(exc)}") from None
     if model.observation_space != env.observation_space:
         raise ModelError(f"{opt} {path}: trained on observations {model.observation_space}, but the "
                          f"environment gives {env.observation_space}; pass the environment keywords it was "
                          f"trained with in {path.with_suffix('.json')}")  # fmt: skip
-    return model
+    return policy
 
 
-def _goal_agent(model: Any, path: Path, env: Any, meta: dict[str, Any], opt: str) -> Any:
+def _goal_agent(
+    model: BaseAlgorithm, path: Path, env: gym.Env, meta: dict[str, Any], opt: str
+) -> PolicyPredictor:
     """``model`` (a goal-level ``MaskablePPO``) inside a ``GoalAgent`` on ``env``, checked."""
     goals = _goals()
     goal_kw, _ = goals.split_goal_kwargs(meta.get("env_kwargs", {}))

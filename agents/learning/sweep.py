@@ -1,7 +1,7 @@
 """Hyper-parameter and seed sweeps of the PPO recipe on Ray Tune (``digslam sweep CONFIG``).
 
 A :class:`SweepConfig` (TOML or JSON, unknown keys rejected) names a base
-:class:`~digslam.agents.learning.train.TrainConfig` (file or table), a search space over its keys
+:class:`~digslam.agents.learning.train_config.TrainConfig` (file or table), a search space over its keys
 (:data:`SPACE_KINDS`: ``grid``, ``choice``, ``uniform``, ``loguniform``, ``randint``; ``env_kwargs`` takes a
 nested table), the seeds (a grid dimension), the samples per grid point, the CPUs per trial, early stopping
 on certified coverage (ASHA and/or a threshold) and where results land. :func:`run_sweep` runs one Tune
@@ -22,12 +22,18 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from digslam.agents.learning.sweep_config import FIXED_KEYS, SPACE_KINDS, SweepConfig
-from digslam.agents.learning.train import EnvFactory, TrainConfig
+from digslam.agents.learning.train_config import TrainConfig
+from digslam.agents.learning.vec_env import EnvFactory
+
+if TYPE_CHECKING:  # the types; stable-baselines3 is imported by the trials only
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    from digslam.agents.common.policy import PolicyPredictor
 
 
 def sweep_trial(params: dict[str, Any], sweep: dict[str, Any]) -> None:
@@ -52,7 +58,7 @@ def sweep_trial(params: dict[str, Any], sweep: dict[str, Any]) -> None:
     callback.flush()
 
 
-def evaluate_coverage(model: Any, cfg: TrainConfig, eval_steps: int = 0) -> tuple[float, float]:
+def evaluate_coverage(model: PolicyPredictor, cfg: TrainConfig, eval_steps: int = 0) -> tuple[float, float]:
     """Mean final certified and true coverage of ``model`` (deterministic) on the held-out maps
     ``cfg.eval_seeds()``; an episode ends with the environment's or after ``eval_steps`` steps (0: no cap)."""
     env = EnvFactory(cfg.env_id, cfg.env_kwargs, cfg.torch_threads)()
@@ -136,7 +142,7 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-def train_with_callback(cfg: TrainConfig, callback: Any) -> Path:
+def train_with_callback(cfg: TrainConfig, callback: BaseCallback) -> Path:
     """``train(cfg)`` with ``callback`` added to SB3's ``learn``."""
     from digslam.agents.learning.train import train
 
@@ -203,7 +209,7 @@ def run_sweep(
     from ray import tune
     from ray.tune.schedulers import ASHAScheduler
 
-    from digslam.agents.evaluation.ray_eval import start_ray
+    from digslam.agents.evaluation.ray_pool import start_ray
 
     path = cfg.experiment_path()
     trainable = tune.with_resources(

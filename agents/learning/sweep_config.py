@@ -12,19 +12,13 @@ ValueError: SweepConfig: unknown key(s) ['seed']; known: ...
 
 from __future__ import annotations
 
-import json
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import field, fields
 from pathlib import Path
 from typing import Any
 
-from digslam.agents.learning.train import TrainConfig
-from digslam.observer.core.config import Config, config_dataclass, reject_unknown
-
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10
-    import tomli as tomllib  # type: ignore[no-redef]
+from digslam.agents.learning.train_config import TrainConfig
+from digslam.observer.core.config import Config, config_dataclass, read_config_file, reject_unknown
 
 #: Kinds of search dimension and their argument (a list of values, or ``[low, high]``).
 SPACE_KINDS = ("grid", "choice", "uniform", "loguniform", "randint")
@@ -129,18 +123,10 @@ class SweepConfig(Config):
         return cls(**data)
 
     @classmethod
-    def from_file(cls, path: str | Path) -> SweepConfig:
-        """Read a ``.toml`` or ``.json`` sweep file."""
-        p = Path(path)
-        if not p.is_file():
-            raise ValueError(f"path: no sweep configuration file {str(p)!r}")
-        if p.suffix == ".json":
-            data = json.loads(p.read_text())
-        elif p.suffix == ".toml":
-            data = tomllib.loads(p.read_text())
-        else:
-            raise ValueError(f"path: sweep configuration must be .toml or .json, got {str(p)!r}")
-        return cls.from_dict(data, root=p.parent)
+    def from_file(cls, path: str | Path, overrides: Iterable[str] = ()) -> SweepConfig:
+        """Read a ``.toml`` or ``.json`` sweep file (:func:`~digslam.observer.core.config.read_config_file`;
+        a relative ``base`` is taken from the file's folder), then apply ``overrides``."""
+        return cls.from_dict(read_config_file(path), root=Path(path).parent).override(overrides)
 
     # --- views --------------------------------------------------------------------------------------------
     def base_config(self) -> TrainConfig:

@@ -1,4 +1,5 @@
-"""Behaviour-cloning warm start of a goal-level learner (``warm_start`` in :class:`~.train.TrainConfig`).
+"""Behaviour-cloning warm start of a goal-level learner (``warm_start`` in
+:class:`~.train_config.TrainConfig`).
 
 Before PPO's first update, :func:`warm_start` plays a teacher (:mod:`digslam.agents.goals.teacher`:
 ``"frontier"``, the frontier agent's pick, ``"rollout"``, a one-step look-ahead over copies of the
@@ -10,6 +11,9 @@ seeds from :data:`DEMO_SEED` on (never the validation or test split). Each level
 not played again: an interrupted warm start resumes where it stopped. The levels are played by ``n_envs``
 worker processes.
 
+With ``warm_start_rounds`` > 1 the rounds after the first are DAgger's: the policy fitted so far drives
+new levels while the teacher labels its decisions, and the fit goes on over everything.
+
 The learner only ever sees the goal observation (from the observer); the rollout teacher's look at the
 simulator goes into its labels, not into any input.
 """
@@ -19,11 +23,18 @@ from __future__ import annotations
 import json
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from digslam.agents.learning.checkpoints import save_model
+from digslam.agents.learning.train_config import TrainConfig
 from digslam.envs.splits import check_not_test
+
+if TYPE_CHECKING:  # stable-baselines3 is imported on use only
+    import torch
+    from sb3_contrib.common.maskable.policies import MaskableActorCriticPolicy
+    from stable_baselines3.common.base_class import BaseAlgorithm
 
 #: First training seed of the demonstration levels (level ``i`` is ``DEMO_SEED + i``, in the train split).
 DEMO_SEED = 900_000
@@ -59,7 +70,7 @@ def _play(job: tuple[str, Mapping[str, Any], str, Mapping[str, Any], int, str, s
 
     lines: list[str] = []
     choose = teacher(name, **{"seed": seed, **teacher_kwargs})  # fresh noise: each level's streams its own
-    data = demonstrations(env, choose, [seed], log=lines.append, act=act)
+    data: dict[str, Any] = demonstrations(env, choose, [seed], log=lines.append, act=act)
     env.close()
     tmp = Path(path).with_suffix(".part.npz")
     np.savez_compressed(tmp, **data)
@@ -106,15 +117,50 @@ def collect(env_id: str, env_kwargs: Mapping[str, Any], name: str, levels: int, 
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 
 
-def clone(model: Any, data: Mapping[str, np.ndarray], epochs: int = 20, batch_size: int = 256,
+def warm_start(cfg: TrainConfig, model: BaseAlgorithm, out: Path) -> None:
+    """Fit ``model`` to ``cfg.warm_start``'s picks: the teacher drives the first ``warm_start_levels``
+    levels; in each further round (``warm_start_rounds``) the policy fitted so far drives ``dagger_levels``
+    new levels (default as many) while the teacher labels its decisions (DAgger), and the fit goes on over
+    everything. Saves ``warm_start_model.zip`` and ``warm_start.json`` (decisions, the teacher's share of
+    non-first picks, accuracy per epoch, per round) in ``out``."""
+    say = print if cfg.verbose else None
+    n, more = cfg.warm_start_levels, cfg.dagger_levels or cfg.warm_start_levels
+    rounds: list[dict[str, Any]] = []
+    parts: list[dict[str, np.ndarray]] = []
+    for r in range(cfg.warm_start_rounds):
+        actor = None
+        if r:
+            actor = out / f"warm_start_round{r}.zip"
+            save_model(model, actor, cfg)
+        first, size = (0, n) if r == 0 else (n + (r - 1) * more, more)
+        parts.append(collect(cfg.env_id, cfg.env_kwargs, cfg.warm_start, size, out, workers=cfg.n_envs,
+                             log=say, first=first, actor=actor))  # fmt: skip
+        data = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+        acc = clone(model, data, epochs=cfg.bc_epochs, seed=cfg.seed + r)
+        picks = data["action"]
+        rounds.append({"decisions": int(len(picks)), "not_first": float(np.mean(picks != 0)),
+                       "accuracy": acc})  # fmt: skip
+        if say is not None:
+            say(f"warm start round {r}: {rounds[-1]['decisions']} decisions, accuracy {acc[-1]:.3f}")
+    report = {"teacher": cfg.warm_start, "levels": n + more * (cfg.warm_start_rounds - 1), "rounds": rounds}
+    (out / "warm_start.json").write_text(json.dumps(report, indent=2))
+    save_model(model, out / "warm_start_model.zip", cfg)
+
+
+def clone(model: BaseAlgorithm, data: Mapping[str, np.ndarray], epochs: int = 20, batch_size: int = 256,
           lr: float = 1e-3, seed: int = 0) -> list[float]:  # fmt: skip
     """Fit ``model``'s policy (a ``MaskablePPO``) to the picks ``data["action"]`` of the observations
     ``data["obs_<key>"]`` by cross-entropy over the valid candidates ``data["mask"]`` (Adam, ``lr``);
     returns the share of picks the policy's most likely candidate matches, after each epoch."""
     import torch
+    from gymnasium import spaces
+    from sb3_contrib.common.maskable.policies import MaskableActorCriticPolicy
 
     policy = model.policy
-    keys = list(policy.observation_space.spaces)
+    if not isinstance(policy, MaskableActorCriticPolicy):
+        raise ValueError(f"model: a MaskablePPO (a masked actor-critic policy), got {type(policy).__name__}")
+    space = policy.observation_space
+    keys = list(space.spaces) if isinstance(space, spaces.Dict) else []
     missing = [k for k in keys if f"obs_{k}" not in data]
     if missing or "action" not in data or "mask" not in data:
         raise ValueError(f"data: demonstrations lack {missing or ['action', 'mask']} for this policy")
@@ -141,14 +187,14 @@ def clone(model: Any, data: Mapping[str, np.ndarray], epochs: int = 20, batch_si
     return acc
 
 
-def _accuracy(policy: Any, data: Mapping[str, np.ndarray], keys: list[str], masks: np.ndarray,
-              actions: Any) -> float:  # fmt: skip
+def _accuracy(policy: MaskableActorCriticPolicy, data: Mapping[str, np.ndarray], keys: list[str],
+              masks: np.ndarray, actions: torch.Tensor) -> float:  # fmt: skip
     import torch
 
     with torch.no_grad():
         obs, _ = policy.obs_to_tensor({k: np.asarray(data[f"obs_{k}"]) for k in keys})
         dist = policy.get_distribution(obs, action_masks=masks)
-        pick = dist.distribution.probs.argmax(dim=1)
+        pick = dist.mode()  # the most likely valid candidate
     return float((pick == actions).float().mean())
 
 
@@ -157,4 +203,5 @@ __all__ = [
     "clone",
     "collect",
     "level_seeds",
+    "warm_start",
 ]

@@ -1,10 +1,8 @@
 """Training wrappers of the low-level PPO: discrete turn-or-go actions and a penalty on tube growth.
 
-The continuous PPO policy of the first release drove itself into a circle: its Gaussian mean for the speed
-saturated at -2.29 before SB3 clipped it to -1, so its deterministic action (the mean) was not the
-behaviour it was trained on (the samples, most of them clipped), and turning while driving widened the pose
-box until nothing more could be certified. Two changes make the deterministic policy the trained one and
-make the tube's cost visible:
+A continuous Gaussian policy whose mean leaves the action box acts, deterministically, unlike the clipped
+samples it was trained on, and turning while driving widens the pose box until nothing more can be
+certified. These wrappers make the deterministic policy the trained one and the tube's cost visible:
 
 * :class:`TurnGoActions`: ``Discrete(len(TURN_GO))`` actions, each a fixed ``(v, ω)`` of the continuous
   space: drive straight (full or slow) or turn in place (either way, full or slow), the motion primitives
@@ -33,10 +31,13 @@ True
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import gymnasium as gym
 import numpy as np
+
+if TYPE_CHECKING:  # stable-baselines3 is imported on use only
+    from stable_baselines3.common.base_class import BaseAlgorithm
 
 #: The discrete actions as normalised ``(v, ω)``: drive full, drive slow, turn left, turn right, turn left
 #: slow, turn right slow.
@@ -45,7 +46,7 @@ TURN_GO = np.array(
     dtype=np.float32,
 )
 
-#: The action modes of :class:`~digslam.agents.learning.train.TrainConfig` (``actions``).
+#: The action modes of :class:`~digslam.agents.learning.train_config.TrainConfig` (``actions``).
 ACTION_MODES = ("continuous", "turn_go")
 
 
@@ -93,14 +94,15 @@ class TubePenalty(gym.Wrapper):
         obs, reward, terminated, truncated, info = self.env.step(action)
         tube = tube_width(info)
         growth = tube - self._tube
+        r = float(reward)
         if math.isfinite(growth) and growth > 0:
-            reward = float(reward) - self.weight * growth
+            r -= self.weight * growth
         self._tube = tube
-        return obs, reward, terminated, truncated, info
+        return obs, r, terminated, truncated, info
 
 
 def wrap_training_env(env: gym.Env, actions: str = "continuous", tube_penalty: float = 0.0) -> gym.Env:
-    """``env`` with the training wrappers a :class:`~digslam.agents.learning.train.TrainConfig` asks for."""
+    """``env`` with the training wrappers a :class:`~.train_config.TrainConfig` asks for."""
     if actions not in ACTION_MODES:
         raise ValueError(f"actions: must be one of {ACTION_MODES}, got {actions!r}")
     if tube_penalty:
@@ -115,7 +117,7 @@ class TurnGoPolicy:
         model: The SB3 model (its action space is ``Discrete(len(TURN_GO))``).
     """
 
-    def __init__(self, model: Any) -> None:
+    def __init__(self, model: BaseAlgorithm) -> None:
         n = getattr(model.action_space, "n", None)
         if n != len(TURN_GO):
             raise ValueError(
@@ -125,8 +127,9 @@ class TurnGoPolicy:
         self.policy = model.policy  # marks an SB3 model for the evaluation loop (no per-episode state)
         self.observation_space = model.observation_space
 
-    def predict(self, observation: Any, state: Any = None, episode_start: Any = None,
-                deterministic: bool = True) -> tuple[np.ndarray, Any]:  # fmt: skip
+    def predict(self, observation: dict[str, np.ndarray], state: tuple[np.ndarray, ...] | None = None,
+                episode_start: np.ndarray | None = None,
+                deterministic: bool = True) -> tuple[np.ndarray, tuple[np.ndarray, ...] | None]:  # fmt: skip
         a, state = self.model.predict(observation, state=state, episode_start=episode_start,
                                       deterministic=deterministic)  # fmt: skip
         return TURN_GO[np.asarray(a, dtype=np.int64)], state

@@ -21,10 +21,17 @@ May import: numpy, scipy, numba, torch (inside the functions that need it), :mod
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # the types; the agent (and torch) are imported on use
+    import gymnasium as gym
+
+    from digslam.agents.prediction.agent import MapSource, PredictiveFrontierAgent
 
 
-def make_predictive(env: Any, predictor: Any = None, seed: int | None = None, **kw: Any) -> Any:
+def make_predictive(
+    env: gym.Env, predictor: MapSource | None = None, seed: int | None = None, **kw: Any
+) -> PredictiveFrontierAgent:
     """A :class:`~.agent.PredictiveFrontierAgent` sized from ``env`` (as the baselines are,
     :func:`digslam.agents.baselines.registry.sizing`), reading ``predictor`` (None: the shipped one)."""
     from digslam.agents.baselines.registry import sizing

@@ -33,11 +33,14 @@ from __future__ import annotations
 import math
 from typing import Any, Protocol
 
+import gymnasium as gym
 import numpy as np
+from gymnasium import spaces
 
 from digslam.agents.baselines.frontier import FrontierAgent
 from digslam.agents.baselines.policy import Memory, View
 from digslam.agents.prediction.gain_jit import visible_gain
+from digslam.envs.stack import observer_of
 
 
 class MapSource(Protocol):
@@ -52,13 +55,12 @@ class TrueMap:
     """The true free share per map pixel of the env's current level (the oracle's map source; module
     docstring). ``env``: a ``digslam/DigCoverage*`` env (possibly wrapped) whose level is being played."""
 
-    def __init__(self, env: Any) -> None:
-        from digslam.agents.baselines.registry import observer_layer
-
-        self.layer = observer_layer(env)
-        if self.layer is None:
-            raise ValueError("env: TrueMap needs a DigCoverage env (a GuaranteedObserver layer)")
-        self._key: Any = None
+    def __init__(self, env: gym.Env) -> None:
+        try:
+            self.layer = observer_of(env)
+        except ValueError:
+            raise ValueError("env: TrueMap needs a DigCoverage env (a GuaranteedObserver layer)") from None
+        self._key: np.ndarray | None = None
         self._free = np.zeros((0, 0))
 
     def free(self, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -88,21 +90,18 @@ class PredictiveFrontierAgent(FrontierAgent):
             unknown pixels in the sensor range's square, no visibility).
         count: The pixels that count as new: ``"unknown"`` (dark and penumbra) or ``"dark"`` only.
         score: ``"ratio"`` (path per predicted gain) or ``"difference"`` (path less ``predicted_weight``
-            times the gain). On 40 validation levels per generator with the shipped predictor (seeds
-            1 000 000-1 000 039, 3000 steps, ``T_level`` speedup over the frontier agent, geometric mean
-            over the 160 levels) the ratio with the defaults below scored 1.163 (room 1.115, rocks 1.213,
-            caves 1.102, rooms 1.226); the difference at weight 160 scored 1.045 (room 0.819), and every
-            weighting of it beside ``gain_weight`` 20-40 lost on the room (0.80-0.86).
+            times the gain; the module docstring says how they differ).
         path_offset: Added to ``c`` in the ratio (m; 10 pixels of the default 64-pixel map): how much a
             goal next to the robot still costs.
         gain_floor: Added to ``g`` in the ratio (a share): a candidate with no predicted gain costs its
             path times ``(gain_scale + gain_floor) / gain_floor``, not infinity.
         gain_scale: The gain (a share) at which the ratio equals ``c + path_offset`` (in pixels), so that
-            the goal hysteresis (:func:`~digslam.agents.baselines.frontier.keep_bound`) keeps its meaning.
+            the goal hysteresis (:func:`~digslam.agents.baselines.navigating.keep_bound`) keeps its meaning.
         **kw: :class:`FrontierAgent` arguments.
     """
 
-    def __init__(self, action_space: Any, observation_space: Any = None, seed: int | None = None,
+    def __init__(self, action_space: spaces.Space, observation_space: spaces.Space | None = None,
+                 seed: int | None = None,
                  predictor: MapSource | None = None, uncertainty: float = 0.0, predict_every: int = 10,
                  n_rays: int = 32, predicted_weight: float = 160.0, gain_weight: float = 0.0,
                  gain: str = "visible", count: str = "unknown", score: str = "ratio",
@@ -171,7 +170,7 @@ class PredictiveFrontierAgent(FrontierAgent):
 
     def shown_prediction(self) -> np.ndarray | None:
         """The free probabilities of the last prediction for the first env (what a demo draws), or None."""
-        mem = self._mem.get(0)
+        mem = self.memory(0)
         return None if mem is None or "pred" not in mem.extra else mem.extra["pred"][0]
 
     def predicted_gain(self, view: View, mem: Memory, candidates: np.ndarray) -> np.ndarray:

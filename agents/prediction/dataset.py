@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from digslam.envs.observation import BASE_CHANNELS
 from digslam.envs.splits import check_not_test
 
 #: Shares of random candidate picks (one drawn per level): the frontier agent's picks and perturbed ones.
@@ -51,9 +52,9 @@ def generate_level(generator: str, seed: int, steps: int = 2000, every: int = 60
                    explore: float | None = None, map_size: int = 64) -> dict[str, Any]:  # fmt: skip
     """Snapshots of one level (module docstring): ``map``, ``state``, ``t`` (low-level step of each),
     ``free``, ``generator``, ``seed`` and ``explore``."""
-    from digslam.agents.baselines.registry import observer_layer
     from digslam.agents.evaluation.suite import GENERATORS
     from digslam.agents.goals.env import GoalSelectionEnv
+    from digslam.envs.stack import observer_of
 
     check_not_test("seed", [seed])
     env_id, kw = GENERATORS[generator]
@@ -63,15 +64,14 @@ def generate_level(generator: str, seed: int, steps: int = 2000, every: int = 60
                            **kw)  # fmt: skip
     try:
         obs, _ = env.reset(seed=seed)
-        layer = observer_layer(env.env)
-        free = free_labels(layer.reachable, map_size)
+        free = free_labels(observer_of(env).reachable, map_size)
         maps, states, ts, last = [], [], [], -every
         done = False
         while not done:
-            t = env._t
-            if t - last >= every:
-                base = env.base_observation
-                maps.append(np.array(base["map"][:4]))
+            t = env.elapsed
+            base = env.base_observation
+            if t - last >= every and base is not None:
+                maps.append(np.array(base["map"][:BASE_CHANNELS]))
                 states.append(np.array(base["state"]))
                 ts.append(t)
                 last = t

@@ -24,7 +24,7 @@ import numpy as np
 from digslam.agents.baselines.policy import View
 from digslam.agents.goals.candidates import Candidates
 from digslam.agents.goals.driver import GoalDriver
-from digslam.agents.prediction.agent import visible_shares
+from digslam.agents.prediction.agent import MapSource, visible_shares
 
 #: The entry point that names :class:`PredictedGain` in a goal env's keywords and a model's sidecar.
 ENTRY_POINT = "digslam.agents.prediction.features:PredictedGain"
@@ -43,7 +43,7 @@ class PredictedGain:
 
     names = ("predicted_gain", "predicted_spread")
 
-    def __init__(self, predictor: Any = None, n_rays: int = 32) -> None:
+    def __init__(self, predictor: MapSource | None = None, n_rays: int = 32) -> None:
         self.predictor, self.n_rays = predictor, int(n_rays)
 
     def __deepcopy__(self, memo: dict[int, Any]) -> PredictedGain:

@@ -1,7 +1,8 @@
 """Training the map predictor end to end: snapshots, fit, validation, weights with their sidecar.
 
 :class:`PredictorConfig` is read from TOML or JSON (``kind = "map_predictor"``, the key by which
-``digslam train`` tells it from a PPO configuration) with ``key=value`` overrides. :func:`fit`:
+``digslam train`` tells it from a PPO configuration) with ``key=value`` overrides
+(:meth:`~digslam.observer.core.config.Config.from_file`). :func:`fit`:
 
 1. writes the snapshots of ``train_levels`` training-split and ``val_levels`` validation-split levels of
    every generator under ``data_dir`` (:func:`.dataset.generate`: one file per level, resumable, in
@@ -32,14 +33,24 @@ from typing import Any
 
 import numpy as np
 
-from digslam.observer.core.config import Config, check, check_finite_pos, check_int, config_dataclass
+from digslam.envs.observation import Channel
+from digslam.observer.core.config import (
+    Config,
+    check,
+    check_finite_pos,
+    check_int,
+    config_dataclass,
+    read_config_file,
+)
 
 #: The value of ``kind`` that marks a map-predictor configuration.
 KIND = "map_predictor"
 
 
 def _generators() -> list[str]:
-    return ["room", "rocks", "caves", "rooms"]
+    from digslam.agents.evaluation.suite import GENERATORS
+
+    return list(GENERATORS)
 
 
 @config_dataclass
@@ -106,19 +117,9 @@ class PredictorConfig(Config):
                 isinstance(v, (int, float)) and math.isfinite(v) and v >= 0, name, f"must be >= 0, got {v!r}"
             )
 
-    @classmethod
-    def from_file(cls, path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> PredictorConfig:
-        """Read a ``.toml`` or ``.json`` file, then apply ``key=value`` overrides."""
-        from digslam.agents.learning.train import apply_overrides, read_config_file
-
-        cfg = cls.from_dict(read_config_file(path))
-        return cls.from_dict(apply_overrides(cfg.to_dict(), overrides))
-
 
 def is_predictor_config(path: str | Path | None) -> bool:
     """Whether the configuration file at ``path`` says ``kind = "map_predictor"``."""
-    from digslam.agents.learning.train import read_config_file
-
     if path is None or not Path(path).is_file():
         return False
     try:
@@ -163,7 +164,7 @@ def _data(cfg: PredictorConfig) -> tuple[dict[str, np.ndarray], dict[str, np.nda
     from digslam.agents.prediction import dataset
     from digslam.envs.splits import seeds
 
-    kw = {
+    kw: dict[str, Any] = {
         "steps": cfg.episode_steps,
         "every": cfg.snapshot_every,
         "progress": cfg.progress,
@@ -218,26 +219,26 @@ def fit(cfg: PredictorConfig, command: str | None = None) -> Path:
         rng = np.random.default_rng((cfg.seed, epoch))
         order = rng.permutation(n)
         net.train()
-        bar = range(per_epoch)
+        bar: Any = None  # a tqdm bar over the epoch's batches
         if cfg.progress:
             from tqdm.auto import tqdm
 
-            bar = tqdm(bar, desc=f"epoch {epoch + 1}/{cfg.epochs}", unit="batch")
+            bar = tqdm(range(per_epoch), desc=f"epoch {epoch + 1}/{cfg.epochs}", unit="batch")
         total = 0.0
-        for b in bar:
+        for b in bar if bar is not None else range(per_epoch):
             idx = np.sort(order[b * cfg.batch_size : (b + 1) * cfg.batch_size])
             maps, labels = augment(train["map"][idx], train["free"][idx], rng)
             x = torch.from_numpy(model.inputs(maps)).to(device)
             y = torch.from_numpy(labels).to(device)
-            w = torch.where(x[:, 0] > 0.5, cfg.clear_weight, 1.0)
+            w = torch.where(x[:, int(Channel.CLEAR)] > 0.5, cfg.clear_weight, 1.0)
             loss = torch.nn.functional.binary_cross_entropy_with_logits(net(x), y, weight=w)
             opt.zero_grad()
             loss.backward()
             opt.step()
             sched.step()
             total += float(loss.detach())
-            if cfg.progress:
-                bar.set_postfix(loss=f"{total / (b + 1):.4f}")  # type: ignore[attr-defined]
+            if bar is not None:
+                bar.set_postfix(loss=f"{total / (b + 1):.4f}")
         epoch += 1
         writer.add_scalar("train/loss", total / per_epoch, epoch)
         p = predict_all(net, val["map"], device)

@@ -33,8 +33,14 @@ from typing import Any
 
 import numpy as np
 
-#: Input channels of the net: clear, penumbra, dark, pose box, row, column.
-N_INPUTS = 6
+from digslam.envs.observation import BASE_CHANNELS
+
+#: Input channels of the net: the observation's clear, penumbra, dark and pose-box channels
+#: (:data:`~digslam.envs.observation.BASE_CHANNELS` of :class:`~digslam.envs.observation.Channel`), then the
+#: pixel's row and column coordinates in ``[-1, 1]``.
+N_INPUTS = BASE_CHANNELS + 2
+#: The net's coordinate input channels.
+ROW, COL = BASE_CHANNELS, BASE_CHANNELS + 1
 #: The shipped weights (their sidecar is the same name with ``.json``).
 SHIPPED = Path(__file__).parents[1] / "data" / "map_predictor.pt"
 
@@ -46,10 +52,10 @@ def inputs(images: np.ndarray) -> np.ndarray:
         img = img[None]
     n, _, m, _ = img.shape
     out = np.empty((n, N_INPUTS, m, m), dtype=np.float32)
-    out[:, :4] = img[:, :4] > 127
+    out[:, :BASE_CHANNELS] = img[:, :BASE_CHANNELS] > 127
     axis = (np.arange(m, dtype=np.float32) + 0.5) / m * 2.0 - 1.0
-    out[:, 4] = axis[None, :, None]
-    out[:, 5] = axis[None, None, :]
+    out[:, ROW] = axis[None, :, None]
+    out[:, COL] = axis[None, None, :]
     return out
 
 
@@ -65,7 +71,7 @@ def _module_base() -> Any:
     return _torch().nn.Module
 
 
-class MapUNet(_module_base()):  # type: ignore[misc]
+class MapUNet(_module_base()):  # type: ignore[misc]  # torch's nn.Module, a base imported on use
     """U-Net of the map predictor (module docstring). ``width``: channels of the first stage."""
 
     def __init__(self, width: int = 8) -> None:
@@ -117,8 +123,7 @@ class Predictor:
     def logits(self, images: np.ndarray) -> np.ndarray:
         """``(N, m, m)`` float32 logits of ``(N, C, m, m)`` (or one ``(C, m, m)``) uint8 maps, on one torch
         thread (the caller's thread count is restored after): a 64 x 64 map takes about 10 ms so, and
-        torch's own pool of two threads spins against the other processes of a parallel evaluation (590 ms
-        a call with two evaluations running on two cores)."""
+        torch's own pool of threads would spin against the other processes of a parallel evaluation."""
         torch = _torch()
         threads = torch.get_num_threads()
         torch.set_num_threads(1)

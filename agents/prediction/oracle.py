@@ -11,18 +11,24 @@ planner (the oracle itself no faster than the heuristics).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # the types; the suite and the agent are imported on use
+    import gymnasium as gym
+
+    from digslam.agents.common.policy import PolicyFactory, PolicyPredictor
+    from digslam.agents.evaluation.suite import SuiteResult
 
 #: The oracle's row name in a suite.
 ORACLE = "oracle"
 
 
-def oracle_factory(**agent_kw: Any) -> Any:
+def oracle_factory(**agent_kw: Any) -> PolicyFactory:
     """A factory ``env -> agent``: the predictive planner reading ``env``'s true map."""
     from digslam.agents.prediction import make_predictive
     from digslam.agents.prediction.agent import TrueMap
 
-    def build(env: Any) -> Any:
+    def build(env: gym.Env) -> PolicyPredictor:
         return make_predictive(env, predictor=TrueMap(env), **agent_kw)
 
     return build
@@ -35,7 +41,7 @@ def oracle_suite(
     generators: Sequence[str] | None = None,
     progress: bool = False,
     **agent_kw: Any,
-) -> Any:
+) -> SuiteResult:
     """The :class:`~digslam.agents.evaluation.suite.SuiteResult` of the oracle alone (module docstring)."""
     from digslam.agents.evaluation.suite import run_suite
 

@@ -24,6 +24,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
+from digslam.envs.observation import Channel
+
 #: Pixels of the ``dilate`` baseline.
 DILATE = 3
 #: Bins of the calibration error.
@@ -32,7 +34,7 @@ ECE_BINS = 10
 
 def open_pixels(maps: np.ndarray) -> np.ndarray:
     """``(N, m, m)`` bool: the pixels that are dark or penumbra in ``(N, C, m, m)`` uint8 maps."""
-    return np.asarray(maps)[:, 0] <= 127
+    return np.asarray(maps)[:, Channel.CLEAR] <= 127
 
 
 def scores(p: np.ndarray, label: np.ndarray, where: np.ndarray) -> dict[str, float]:
@@ -59,7 +61,7 @@ def base_rate(maps: np.ndarray, labels: np.ndarray) -> float:
 
 def baselines(maps: np.ndarray, rate: float) -> dict[str, np.ndarray]:
     """``(N, m, m)`` free probabilities of the two reference guesses (module docstring)."""
-    clear = np.asarray(maps)[:, 0] > 127
+    clear = np.asarray(maps)[:, Channel.CLEAR] > 127
     near = ndimage.binary_dilation(clear, structure=np.ones((1, 2 * DILATE + 1, 2 * DILATE + 1), bool))
     return {"base_rate": np.full(clear.shape, float(rate)), "dilate": near.astype(np.float64)}
 

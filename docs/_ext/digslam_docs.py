@@ -310,9 +310,21 @@ def write_gallery(out: Path) -> int:
     return len(cards) + 1
 
 
+def write_observation(out: Path) -> Path:
+    """The observation's table from its schema (:mod:`digslam.envs.observation`), included by
+    ``environments.md``: the docs never restate the layout by hand."""
+    from digslam.envs.observation import markdown_table
+
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / "observation.inc"
+    path.write_text(markdown_table() + "\n", encoding="utf-8")
+    return path
+
+
 def _generate(app: object) -> None:
     write_api(DOCS / "api")
     write_gallery(DOCS / "gallery")
+    write_observation(DOCS / "_generated")
 
 
 def _drop_type_docstring(app, what, name, obj, options, lines):  # noqa: ANN001 (Sphinx's event signature)

@@ -166,9 +166,9 @@ class DigCoverageConfig(Config):
             known = sorted((own - {"observer", "explore"}) | obs | raw)
             hints = [m for k in unknown for m in difflib.get_close_matches(k, known, n=1)]
             hint = f" (did you mean {', '.join(map(repr, hints))}?)" if hints else ""
-            mine = sorted(own - {"observer", "explore"})
+            coverage_keys = sorted(own - {"observer", "explore"})
             raise ValueError(
-                f"DigCoverage: unknown keyword(s) {unknown}{hint}; known: coverage {mine}, observer "
+                f"DigCoverage: unknown keyword(s) {unknown}{hint}; known: coverage {coverage_keys}, observer "
                 f"{sorted(obs)}, raw environment {sorted(raw)}"
             )
         mine = {k: v for k, v in kwargs.items() if k in own}

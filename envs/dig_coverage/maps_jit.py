@@ -9,18 +9,13 @@ covers cells ``starts[p] <= c < starts[p + 1]`` with ``starts[p] = floor(p n / m
 * otherwise it is PENUMBRA (mixed or possibly explored: nothing is claimed).
 
 The per-cell work is compiled (``digslam.observer.core.scalar_jit.njit``): :func:`observer_sets` turns the
-filter's
-certainly / possibly sensed and dug cells into the explored codes, the clear and dark masks and the
-certified count in one pass, and :func:`sets_and_map` keeps them and the image up to date on the window
-of cells a step changed; :func:`observe` does that, then the pose-box channel, the ``"state"`` vector and
-the copies ``info`` hands out, all in one compiled call per step (the wrapper's fast path).
+filter's certainly / possibly sensed and dug cells into the explored codes, the clear and dark masks and
+the certified count in one pass (:func:`update_sets` on a window of cells), and :func:`sets_and_map` keeps
+them and the image up to date on the window of cells a step changed (:func:`fill_pixels` on the pixels
+whose blocks meet it). :mod:`.observe_jit` draws a whole observation with these kernels.
 
-**The observation holds no ground truth.** The image and the state are drawn from the filter's sets, the
-pose and heading boxes, the grid and the step count only. The ``reach`` plane (the true reachable free
-cells) feeds nothing but the count these kernels return, which the wrapper puts in ``info`` and the reward;
-the state's certified value is the share of the *grid's* cells that are clear, not of the reachable ones
-(the grid is the observer's own, fixed by its configuration; the reachable area is what a real robot does
-not know, and a share of it would tell the agent how much is left to find).
+The ``reach`` plane of :class:`MapPlanes` (the true reachable free cells, ground truth) feeds nothing but
+the count these kernels return, which the wrapper puts in ``info`` and the reward, never a pixel.
 
 >>> clear = np.zeros((4, 4), bool); clear[:2, :2] = True; clear[0, 2] = True
 >>> dark = np.zeros((4, 4), bool); dark[2:, 2:] = True
@@ -31,14 +26,13 @@ not know, and a share of it would tell the agent how much is left to find).
 
 from __future__ import annotations
 
-import math
 from bisect import bisect_left, bisect_right
 from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
 
-from digslam.observer.core.grid_jit import window
+from digslam.envs.observation import Channel
 from digslam.observer.core.scalar_jit import njit
 from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 
@@ -87,45 +81,14 @@ class MapPlanes(NamedTuple):
     reach: np.ndarray
 
 
-class MapContext(NamedTuple):
-    """What :func:`observe` reads and keeps between steps, built once per episode by :func:`map_context`
-    (flat on purpose: each field, and each nested tuple more, costs at every call from Python).
-
-    Attributes:
-        sure, maybe, free: ``(ny, nx)`` bool, the filter's certainly and possibly sensed cells and ``M⁻``
-            (read: the filter's own arrays).
-        explored, clear, dark, reach: the map's cell sets, ``(ny, nx)`` uint8 planes (:class:`MapPlanes`),
-            kept up to date on the cells a step changed.
-        base: ``(3, m, m)`` uint8, the clear / penumbra / dark channels of the map, kept between steps.
-        row_start, row_end, col_start, col_end: the pixel blocks (:class:`PixelBlocks`).
-        xs, nys: the grid's exact cell bounds (``nys = -ys``), for the pose-box channel; the state is
-            normalised over the grid's frame ``[xs[0], xs[-1]] × [-nys[-1], -nys[0]]``.
-        horizon: the episode's step horizon (the state's elapsed-steps value is ``steps / horizon``).
-    """
-
-    sure: np.ndarray
-    maybe: np.ndarray
-    free: np.ndarray
-    explored: np.ndarray
-    clear: np.ndarray
-    dark: np.ndarray
-    reach: np.ndarray
-    base: np.ndarray
-    row_start: np.ndarray
-    row_end: np.ndarray
-    col_start: np.ndarray
-    col_end: np.ndarray
-    xs: np.ndarray
-    nys: np.ndarray
-    horizon: float
-
-
 @njit
-def _fill(clear: np.ndarray, dark: np.ndarray, img: np.ndarray, ch: int, blocks: PixelBlocks,
-          pix: tuple[int, int, int, int]) -> None:  # fmt: skip
-    """Pixels ``pix = (p0, p1, q0, q1)`` (rows ``p0:p1``, columns ``q0:q1``) of channels ``ch, ch + 1,
-    ch + 2`` of ``img`` (255 / 0): all clear, mixed, all dark per pixel block. The masks come as ``uint8``
-    views; each block row is first AND-reduced over its cells' rows."""
+def fill_pixels(clear: np.ndarray, dark: np.ndarray, img: np.ndarray, ch: int, blocks: PixelBlocks,
+                pix: tuple[int, int, int, int]) -> None:  # fmt: skip
+    """Pixels ``pix = (p0, p1, q0, q1)`` (rows ``p0:p1``, columns ``q0:q1``) of channels ``ch +
+    Channel.CLEAR``, ``ch + Channel.PENUMBRA`` and ``ch + Channel.DARK`` of ``img`` (255 / 0): all clear,
+    mixed, all dark per pixel block (``ch``: 0 for the map's own channels, ``Channel.CROP_CLEAR`` for the
+    crop window's, :class:`~digslam.envs.observation.Channel`). The masks come as ``uint8`` views; each
+    block row is first AND-reduced over its cells' rows."""
     p0, p1, q0, q1 = pix
     if p0 >= p1 or q0 >= q1:
         return
@@ -144,7 +107,8 @@ def _fill(clear: np.ndarray, dark: np.ndarray, img: np.ndarray, ch: int, blocks:
             for j in range(w):
                 ac[j] &= cr[j]
                 ad[j] &= dr[j]
-        o0, o1, o2 = img[ch, p, q0:q1], img[ch + 1, p, q0:q1], img[ch + 2, p, q0:q1]
+        o0, o1 = img[ch + Channel.CLEAR, p, q0:q1], img[ch + Channel.PENUMBRA, p, q0:q1]
+        o2 = img[ch + Channel.DARK, p, q0:q1]
         for q in range(q1 - q0):
             k0, k1 = cs[q0 + q] - j0, ce[q0 + q] - j0
             c, d = ac[k0], ad[k0]
@@ -158,17 +122,19 @@ def _fill(clear: np.ndarray, dark: np.ndarray, img: np.ndarray, ch: int, blocks:
 
 
 def fill_map(clear: np.ndarray, dark: np.ndarray, img: np.ndarray, ch: int = 0) -> None:
-    """Write the clear / penumbra / dark pixel masks of the cell masks into ``img[ch : ch + 3]`` (0 / 255)."""
+    """Write the clear / penumbra / dark pixel masks of the cell masks into the channels ``ch +
+    Channel.CLEAR``, ``ch + Channel.PENUMBRA``, ``ch + Channel.DARK`` of ``img`` (0 / 255; see
+    :func:`fill_pixels`)."""
     blocks = pixel_blocks(clear.shape, img.shape[-1])
     u8 = [np.ascontiguousarray(v).view(np.uint8) for v in (clear, dark)]
-    _fill(u8[0], u8[1], img, ch, blocks, (0, blocks.row_start.size, 0, blocks.col_start.size))
+    fill_pixels(u8[0], u8[1], img, ch, blocks, (0, blocks.row_start.size, 0, blocks.col_start.size))
 
 
 def three_state(clear: np.ndarray, dark: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(clear, penumbra, dark)`` pixel masks of side ``m`` (mutually exclusive, covering every pixel)."""
     img = np.empty((3, m, m), dtype=np.uint8)
     fill_map(np.asarray(clear, dtype=bool), np.asarray(dark, dtype=bool), img)
-    return img[0] > 0, img[1] > 0, img[2] > 0
+    return img[Channel.CLEAR] > 0, img[Channel.PENUMBRA] > 0, img[Channel.DARK] > 0
 
 
 def all_blocks(mask: np.ndarray, m: int) -> np.ndarray:
@@ -177,8 +143,8 @@ def all_blocks(mask: np.ndarray, m: int) -> np.ndarray:
 
 
 @njit
-def _sets(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, planes: MapPlanes,
-          win: tuple[int, int, int, int]) -> int:  # fmt: skip
+def update_sets(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, planes: MapPlanes,
+                win: tuple[int, int, int, int]) -> int:  # fmt: skip
     """The cells ``win = (r0, r1, c0, c1)`` of ``planes``; returns the change of the clear cells inside
     ``planes.reach``."""
     r0, r1, c0, c1 = win
@@ -209,17 +175,18 @@ def _sets(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, planes: MapPlan
 @njit
 def _sets_and_map(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, planes: MapPlanes, img: np.ndarray,
                   blocks: PixelBlocks, win: tuple[int, int, int, int]) -> int:  # fmt: skip
-    """:func:`sets_and_map` (compiled): :func:`_sets` of ``win``, then :func:`_fill` of its pixels."""
+    """:func:`sets_and_map` (compiled): :func:`update_sets` of ``win``, then :func:`fill_pixels` of its
+    pixels."""
     r0, r1, c0, c1 = win
     ny, nx = sure.shape
-    n = _sets(sure, maybe, free, planes, win)
-    pix = (*_pixels(blocks.row_start, r0, r1, ny), *_pixels(blocks.col_start, c0, c1, nx))
-    _fill(planes.clear.view(np.uint8), planes.dark.view(np.uint8), img, 0, blocks, pix)
+    n = update_sets(sure, maybe, free, planes, win)
+    pix = (*pixel_span(blocks.row_start, r0, r1, ny), *pixel_span(blocks.col_start, c0, c1, nx))
+    fill_pixels(planes.clear.view(np.uint8), planes.dark.view(np.uint8), img, 0, blocks, pix)
     return n
 
 
 @njit
-def _pixels(s: np.ndarray, r0: int, r1: int, n: int) -> tuple[int, int]:
+def pixel_span(s: np.ndarray, r0: int, r1: int, n: int) -> tuple[int, int]:
     """:func:`pixel_range` on the block starts ``s`` (compiled twin, same result): ``np.searchsorted`` with
     ``side="right"`` is ``bisect_right`` and ``side="left"`` is ``bisect_left``."""
     if r0 >= r1:
@@ -229,134 +196,7 @@ def _pixels(s: np.ndarray, r0: int, r1: int, n: int) -> tuple[int, int]:
     p1 = np.searchsorted(s, r1 - 1, side="right")
     if n < m:  # several pixels share a cell: take them all (bisect_left(s, s[p0]))
         p0 = np.searchsorted(s, s[p0], side="left")
-    return max(p0, 0), min(p1, m)
-
-
-@njit
-def observe(maps: MapContext, pose_lo: np.ndarray, pose_hi: np.ndarray, heading: tuple[float, float],
-            win: tuple[int, int, int, int], steps: int, n_prev: int, img: np.ndarray, state: np.ndarray,
-            snap: np.ndarray) -> int:  # fmt: skip
-    """One step of the wrapper's observation in one compiled call: :func:`sets_and_map` of the window
-    ``win`` of cells the step changed into the planes and ``base`` of ``maps`` (the clear / penumbra / dark
-    channels), then ``img[:3] = base``, ``img[3]`` the pose-box footprint (the pixels whose blocks meet the
-    cells of the position box ``pose_lo``, ``pose_hi``, :func:`~digslam.observer.core.grid_jit.window`)
-    and the 11 values of ``state`` (the wrapper's ``"state"``, with the heading interval ``heading``; its
-    ``state[9]`` is the share of the grid's cells that are clear, from the observer alone);
-    ``snap`` ``(3, ny, nx)`` uint8 receives copies of the explored codes, the clear mask and ``maps.free``
-    (an empty ``snap``, ``(3, 0, 0)``: no copies).
-
-    ``steps`` is the number of elapsed steps and ``n_prev`` the certified count before the step (clear cells
-    in ``maps.reach``, ground truth); returns the new count, which enters neither ``img`` nor ``state``. No
-    argument checks: the wrapper's own arrays (:class:`MapContext`, or the plain tuple of its fields).
-    :func:`observe_step` is the same step with both counts kept by the caller (what the wrapper calls).
-    """
-    counts = np.array([n_prev, -1], np.int64)
-    _observe(MapContext(*maps), pose_lo, pose_hi, heading, win, steps, counts, img, state, snap)
-    return counts[0]
-
-
-@njit
-def observe_step(maps: tuple, pose_lo: np.ndarray, pose_hi: np.ndarray, heading: tuple[float, float],
-                 win: tuple[int, int, int, int], steps: int, counts: np.ndarray, img: np.ndarray,
-                 state: np.ndarray, snap: np.ndarray) -> None:  # fmt: skip
-    """:func:`observe` with ``maps`` the plain tuple of the fields of a :class:`MapContext` (numba types a
-    plain tuple argument in C, a named tuple field by field in Python: about 1.5 µs less per call) and
-    ``counts`` ``(2,)`` int64, updated in place: the certified count (``observe``'s ``n_prev`` and result)
-    and the number of clear cells of the grid (the state's certified share). Given that number before the
-    step (``>= 0``), only the cells of ``win`` are counted again (the others did not change); ``-1``: all
-    of them are counted. Same image, state and snapshot as :func:`observe`, to the bit."""
-    _observe(MapContext(*maps), pose_lo, pose_hi, heading, win, steps, counts, img, state, snap)
-
-
-@njit
-def _count(c8: np.ndarray, win: tuple[int, int, int, int]) -> int:
-    """The number of ones of the ``uint8`` 0 / 1 plane ``c8`` in the cells ``win = (r0, r1, c0, c1)``."""
-    r0, r1, c0, c1 = win
-    n = 0
-    for i in range(r0, r1):
-        row = c8[i, c0:c1]
-        for j in range(row.size):
-            n += np.int64(row[j])
-    return n
-
-
-@njit
-def _observe(maps: MapContext, pose_lo: np.ndarray, pose_hi: np.ndarray, heading: tuple[float, float],
-             win: tuple[int, int, int, int], steps: int, counts: np.ndarray, img: np.ndarray,
-             state: np.ndarray, snap: np.ndarray) -> None:  # fmt: skip
-    """The body of :func:`observe` and :func:`observe_step` (``counts`` as in :func:`observe_step`)."""
-    sure, free = maps.sure, maps.free
-    ny, nx = sure.shape
-    planes = MapPlanes(maps.explored, maps.clear, maps.dark, maps.reach)
-    blocks = PixelBlocks(maps.row_start, maps.row_end, maps.col_start, maps.col_end)
-    base = maps.base
-    r0, r1, c0, c1 = win
-    p0, p1 = _pixels(blocks.row_start, r0, r1, ny)
-    q0, q1 = _pixels(blocks.col_start, c0, c1, nx)
-    c8, d8 = planes.clear.view(np.uint8), planes.dark.view(np.uint8)
-    n_clear = counts[1]
-    if n_clear >= 0:  # the clear cells outside the window are unchanged: count the window before and after
-        n_clear -= _count(c8, win)
-    counts[0] += _sets(sure, maps.maybe, free, planes, win)
-    if n_clear >= 0:
-        n_clear += _count(c8, win)
-    _fill(c8, d8, base, 0, blocks, (p0, p1, q0, q1))
-    e8, c8, s8 = planes.explored.view(np.uint8).reshape(-1), c8.reshape(-1), snap.reshape(-1)
-    f8 = free.view(np.uint8).reshape(-1)
-    k = e8.size
-    s_e, s_c, s_f = s8[:k], s8[k : 2 * k], s8[2 * k :]  # the snapshot: explored, clear, free
-    if n_clear < 0:  # every clear cell of the grid: the state's certified share (no ground truth)
-        n_clear = 0
-        for i in range(k):  # (slices indexed from 0: no wraparound checks, the loops vectorize)
-            n_clear += np.int64(c8[i])
-    counts[1] = n_clear
-    if s8.size:  # the snapshot, when asked for (an empty ``snap``: none)
-        for i in range(k):
-            s_e[i] = e8[i]
-        for i in range(k):
-            s_c[i] = c8[i]
-        for i in range(k):
-            s_f[i] = f8[i]
-    b8 = base.reshape(-1)  # flat loops (C-contiguous): they vectorize
-    k = b8.size
-    o_b, o_p = img.reshape(-1)[:k], img.reshape(-1)[k : k + k // 3]
-    for i in range(k):
-        o_b[i] = b8[i]
-    for i in range(k // 3):
-        o_p[i] = 0
-    x0, y0, x1, y1 = pose_lo[0], pose_lo[1], pose_hi[0], pose_hi[1]
-    f0, f1, g0, g1 = window(maps.xs, maps.nys, x0, y0, x1, y1)
-    p0, p1 = _pixels(blocks.row_start, f0, f1, ny)
-    q0, q1 = _pixels(blocks.col_start, g0, g1, nx)
-    full = np.uint8(255)
-    for p in range(p0, p1):
-        row = img[3, p]
-        for q in range(q0, q1):
-            row[q] = full
-    h0, h1 = heading
-    xs, nys = maps.xs, maps.nys
-    gx0, gx1, gy0, gy1 = xs[0], xs[xs.size - 1], -nys[nys.size - 1], -nys[0]  # the frame (exact)
-    cx, cy, hx, hy = 0.5 * (gx0 + gx1), 0.5 * (gy0 + gy1), 0.5 * (gx1 - gx0), 0.5 * (gy1 - gy0)
-    hm, hw = 0.5 * (h0 + h1), 0.5 * (h1 - h0)
-    state[0] = min(max((x0 - cx) / hx, -1.0), 1.0)
-    state[1] = min(max((y0 - cy) / hy, -1.0), 1.0)
-    state[2] = min(max((x1 - cx) / hx, -1.0), 1.0)
-    state[3] = min(max((y1 - cy) / hy, -1.0), 1.0)
-    state[4], state[5] = math.cos(hm), math.sin(hm)
-    state[6] = min(hw / math.pi, 1.0)
-    state[7] = math.tanh(max(x1 - x0, y1 - y0))
-    state[8] = min(steps / maps.horizon, 1.0)
-    state[9] = n_clear / ny / nx
-    state[10] = 1.0
-
-
-def map_context(sets: tuple[np.ndarray, np.ndarray, np.ndarray], planes: MapPlanes, base: np.ndarray,
-                xs: np.ndarray, nys: np.ndarray, horizon: float) -> MapContext:  # fmt: skip
-    """The :class:`MapContext` of :func:`observe`: the filter's ``sets = (sure, maybe, free)``, the caller's
-    ``planes`` and ``base`` (kept), the pixel blocks of ``base.shape[-1]`` pixels a side, the grid's cell
-    bounds ``xs``, ``nys = -ys`` (its frame's ends first and last) and the ``horizon``."""
-    blocks = pixel_blocks(planes.clear.shape, base.shape[-1])
-    return MapContext(*sets, *planes, base, *blocks, xs, nys, float(horizon))
+    return max(int(p0), 0), min(int(p1), m)
 
 
 @lru_cache(maxsize=64)
@@ -384,7 +224,7 @@ def observer_sets(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, reach: 
     _check_sets((sure, maybe, free, reach, explored, clear, dark))
     clear[:] = False
     planes = MapPlanes(explored, clear, dark, reach)
-    return int(_sets(sure, maybe, free, planes, (0, sure.shape[0], 0, sure.shape[1])))
+    return int(update_sets(sure, maybe, free, planes, (0, sure.shape[0], 0, sure.shape[1])))
 
 
 def sets_and_map(sure: np.ndarray, maybe: np.ndarray, free: np.ndarray, reach: np.ndarray,
@@ -422,19 +262,18 @@ def crop_window(mask: np.ndarray, r0: int, c0: int, k: int, fill: bool) -> np.nd
 
 
 __all__ = [
-    "MapContext",
     "MapPlanes",
     "PixelBlocks",
     "all_blocks",
     "block_starts",
     "crop_window",
     "fill_map",
-    "map_context",
-    "observe",
-    "observe_step",
+    "fill_pixels",
     "observer_sets",
     "pixel_blocks",
     "pixel_range",
+    "pixel_span",
     "sets_and_map",
     "three_state",
+    "update_sets",
 ]

@@ -1,6 +1,6 @@
 """Guarantee monitor: checks every step's claims of the online observer against the privileged ground truth.
 
-Three claims are checked (a debug option of :class:`~.observer_wrapper.GuaranteedObserver`, used by the
+Three claims are checked (a debug option of :class:`~.wrapper.GuaranteedObserver`, used by the
 tests); the first violation raises :class:`GuaranteeViolation` (a ``RuntimeError``) carrying the step's
 record and truth:
 
@@ -10,8 +10,9 @@ record and truth:
 3. every truly sensed point lies in clear ∪ penumbra: points drawn in each true sector (below the true range,
    or ``r_max`` without echo) must not fall in a dark cell;
 4. (when given the wrapper's ``coverage``) certified coverage never exceeds ground-truth coverage: both are
-   counts of cells of the same reachable free area (:func:`.observer_wrapper.reachable_free`), the clear
-   ones against those whose centre was truly sensed (:meth:`.coverage.Coverage.on_cells`).
+   counts of cells of the same reachable free area (:func:`.wrapper.reachable_free`), the clear ones
+   against those whose centre was truly sensed
+   (:meth:`~digslam.envs.explore.coverage.Coverage.on_cells`).
 
 Once the filter reports an inconsistency its claims are withdrawn, so nothing more is checked.
 
@@ -26,7 +27,7 @@ Once the filter reports an inconsistency its claims are withdrawn, so nothing mo
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -35,6 +36,12 @@ from digslam.envs.sim.world import World
 from digslam.observer.record.grid import Grid
 from digslam.observer.thick.cells import DARK
 
+if TYPE_CHECKING:  # (types only)
+    from digslam.envs.explore.coverage import Coverage
+    from digslam.envs.explore.truth import GroundTruth
+    from digslam.observer.online.observer import OnlineDigSlam
+    from digslam.observer.record.mission import MissionRecord
+
 #: Sample points drawn per sensor and step for claim 3.
 SENSED_SAMPLES = 32
 
@@ -42,7 +49,7 @@ SENSED_SAMPLES = 32
 class GuaranteeViolation(RuntimeError):
     """A false claim of the observer; ``record`` and ``truth`` are the step's data."""
 
-    def __init__(self, msg: str, step: int, record: Any, truth: Any) -> None:
+    def __init__(self, msg: str, step: int, record: MissionRecord, truth: GroundTruth) -> None:
         super().__init__(f"step {step}: {msg}\nrecord: {record!r}")
         self.step, self.record, self.truth = step, record, truth
 
@@ -70,11 +77,11 @@ class GuaranteeMonitor:
         world: the ground truth.
         grid: the observer's grid.
         coverage: ``(reachable, truth)``: the reachable free cells ``(ny, nx)`` (row 0 at the top) and the
-            ground-truth :class:`~.coverage.Coverage` over them, updated before each :meth:`check`; then
-            claim 4 is checked too.
+            ground-truth :class:`~digslam.envs.explore.coverage.Coverage` over them, updated before each
+            :meth:`check`; then claim 4 is checked too.
     """
 
-    def __init__(self, world: World, grid: Grid, coverage: tuple[np.ndarray, Any] | None = None) -> None:
+    def __init__(self, world: World, grid: Grid, coverage: tuple[np.ndarray, Coverage] | None = None) -> None:
         self.world, self.grid, self.coverage = world, grid, coverage
         self.checked = np.zeros(grid.shape, dtype=bool)
         self.rng = np.random.default_rng(0)
@@ -106,7 +113,7 @@ class GuaranteeMonitor:
                 bad[c[ci[hit]]] = True
         return np.stack([rows[bad], cols[bad]], axis=1)
 
-    def check(self, filt: Any, truth: Any, record: Any, step: int) -> None:
+    def check(self, filt: OnlineDigSlam, truth: GroundTruth, record: MissionRecord, step: int) -> None:
         """Check the filter's current claims; raise :class:`GuaranteeViolation` on the first false one."""
         if not filt.consistent:
             return
@@ -152,7 +159,7 @@ class GuaranteeMonitor:
             p = pts[inside][dark][0]
             fail(f"truly sensed point {p.tolist()} lies in a dark cell")
 
-    def sensed_points(self, pose: np.ndarray, record: Any, ranges: np.ndarray) -> np.ndarray:
+    def sensed_points(self, pose: np.ndarray, record: MissionRecord, ranges: np.ndarray) -> np.ndarray:
         """Random points of the true sensed sectors (below the true range, or ``r_max`` without echo)."""
         reach = np.where(np.isfinite(ranges), ranges, record.r_max)
         n, k = reach.size, SENSED_SAMPLES

@@ -8,18 +8,29 @@ pose box, the dig zone ``M⁻`` and the explored thick set, and the wrapper hand
   penumbra, dark (conservative downsampling, :mod:`.maps_jit`), the pose-box footprint, and with
   ``crop`` three more channels clear / penumbra / dark of a ``crop`` x ``crop`` m window centred on the pose
   box (world-aligned; outside the grid counts as dark);
-* ``"state"``: ``float32 (11,)``: the pose box ``(x⁻, y⁻, x⁺, y⁺)`` normalised to ``[-1, 1]`` over the grid
-  frame, ``cos``/``sin`` of the mid heading and the heading half-width over ``π``, ``tanh`` of the tube width
-  (m), the elapsed share of ``horizon``, the certified share of the grid (clear cells over all the grid's
-  cells: the clear area in m² over the grid's area) and the consistency flag.
+* ``"state"``: ``float32 (N_STATE,)``: the pose box ``(x⁻, y⁻, x⁺, y⁺)`` normalised to ``[-1, 1]`` over the
+  grid frame, ``cos``/``sin`` of the mid heading and the heading half-width over ``π``, ``tanh`` of the tube
+  width (m), the elapsed share of ``horizon``, the certified share of the grid (clear cells over all the
+  grid's cells: the clear area in m² over the grid's area) and the consistency flag.
+
+The layout (each channel's and each state entry's index and meaning) is declared once in
+:mod:`digslam.envs.observation` (:class:`~digslam.envs.observation.Channel`,
+:class:`~digslam.envs.observation.State`); :func:`.observe_jit.observe_step` writes it.
 
 **Observations from the observer only.** Everything in ``"map"`` and ``"state"`` comes from the filter's
 sets and boxes, the grid and the step count: two worlds that give the same records (and the same start
 box) give the same observations. Ground truth (the certifiable reachable free area, ``truth``) enters only
-the reward, the termination and ``info``. So ``state[9]`` is *not* ``info["certified_coverage"]``: that one
-is a share of the certifiable reachable free area, which a real robot does not know and which would tell the
-agent how much is left to find; the state's value grows with the same clear area but over a denominator
-fixed in advance.
+the reward, the termination and ``info``. So ``state[State.CERTIFIED]`` is *not*
+``info["certified_coverage"]``: that one is a share of the certifiable reachable free area, which a real
+robot does not know and which would tell the agent how much is left to find; the state's value grows with
+the same clear area but over a denominator fixed in advance.
+
+**Reward and termination: ground truth over the reachable free area.** The wrapper keeps the ground-truth
+coverage of the reachable free area (:attr:`GuaranteedObserver.truth_coverage`, updated from
+``info["truth"]``): the reward is the area it newly and truly sensed (m²), the episode terminates when all of
+it is sensed (or when the env below terminates), and ``info["coverage"]`` is its share, equal to
+``info["true_coverage"]``. (:class:`~digslam.envs.dig_coverage.env.DigCoverageEnv` rewards the certified area
+instead.)
 
 ``info`` adds the pose box (``pose_box (2, 2)``, ``heading_box (2,)``), ``certified_coverage``
 (clear cells in the certifiable reachable free area over that area, :func:`reachable_free`: closed cells
@@ -73,33 +84,26 @@ True
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Mapping
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
-from gymnasium import spaces
 from scipy import ndimage
 
 from digslam.envs.dig_coverage.config import ObserverConfig
-from digslam.envs.dig_coverage.maps_jit import (
-    MapPlanes,
-    crop_window,
-    fill_map,
-    map_context,
-    observe_step,
-)
+from digslam.envs.dig_coverage.maps_jit import MapPlanes, crop_window, fill_map
 from digslam.envs.dig_coverage.monitor import GuaranteeMonitor
+from digslam.envs.dig_coverage.observe_jit import map_context, observe_step
 from digslam.envs.explore.coverage import Coverage
+from digslam.envs.explore.env import ExploreEnv
+from digslam.envs.observation import N_STATE, Channel, n_channels, observation_space
 from digslam.envs.sim.raster import FREE, rasterize
 from digslam.envs.sim.world import World
 from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam
 from digslam.observer.record.grid import Grid
 from digslam.observer.thick.cells import PENUMBRA
-
-N_STATE = 11
 
 
 def make_grid(cfg: ObserverConfig, world_frame: tuple[float, ...]) -> Grid:
@@ -155,10 +159,15 @@ class GuaranteedObserver(gym.Wrapper):
             filter's ``OnlineConfig.q``).
         config: an :class:`ObserverConfig`, a mapping, or an ``OnlineConfig`` (filter settings only).
 
-    When ``env`` is the raw env itself (no wrapper between), :meth:`step` calls its internal fast path
-    ``_step(action, observe=False)``: the agent sees this wrapper's observation only, so the raw one is not
-    built on each step. The raw env's own ``step`` keeps the Gymnasium contract.
+    It reads the env below through its public API and ``info`` only: ``env.unwrapped``'s ``generator``,
+    ``world`` and ``suite``, the record and the ground truth of each step's ``info``. When ``env`` is an
+    :class:`~digslam.envs.explore.env.ExploreEnv` itself (no wrapper between), :meth:`step` calls its
+    :meth:`~digslam.envs.explore.env.ExploreEnv.step_record`: the agent sees this wrapper's observation only,
+    so the raw one is not built on each step.
     """
+
+    n_reachable: int
+    _clear_count: int
 
     def __init__(
         self,
@@ -179,28 +188,29 @@ class GuaranteedObserver(gym.Wrapper):
         if q is not None:
             if not (isinstance(q, int) and not isinstance(q, bool) and q >= 0):
                 raise ValueError(f"q: must be an integer >= 0 (outliers allowed per step), got {q!r}")
-            cfg = cfg.replace(q=q, online=dataclasses.replace(cfg.online, q=q))
+            cfg = cfg.replace(q=q, online=cfg.online.replace(q=q))
         self.obs_config = cfg
         raw = env.unwrapped
+        if not isinstance(raw, ExploreEnv):
+            raise TypeError(f"env: must be an ExploreEnv, possibly wrapped; got {type(raw).__name__} below")
+        self._explore = raw  # the raw env at the bottom (read through its public attributes only)
         self.grid = make_grid(cfg, raw.generator.frame)
         m = cfg.map_size
-        self.n_channels = 4 + (3 if cfg.crop is not None else 0)
-        self.observation_space = spaces.Dict(
-            {
-                "map": spaces.Box(0, 255, shape=(self.n_channels, m, m), dtype=np.uint8),
-                "state": spaces.Box(-1.0, 1.0, shape=(N_STATE,), dtype=np.float32),
-            }
-        )
+        self.n_channels = n_channels(cfg.crop is not None)
+        self.observation_space = observation_space(m, cfg.crop is not None)
         self.filter = OnlineDigSlam(self.grid, cfg.online)
         # nothing between reads the raw observation, which this wrapper replaces: skip building it
-        self._fast = env is raw
+        self._direct: ExploreEnv | None = env if isinstance(env, ExploreEnv) else None
         self._extra_info: dict[str, Any] = {}  # constant keys added to every info (subclasses)
         g = self.grid
         self.cell_area = g.cell_size[0] * g.cell_size[1]
         self._obs: tuple[np.ndarray, np.ndarray] = (np.zeros(0, np.uint8), np.zeros(0, np.float32))
-        self._reach_world: Any = None
+        self._reach_world: World | None = None
         self.reachable = np.zeros(g.shape, dtype=bool)
         self.monitor: GuaranteeMonitor | None = None
+        self.n_reachable = 1  # the reachable free cells (at least 1: a denominator)
+        self._clear_count = 0  # the certified count at the last reward (DigCoverageEnv)
+        self._suite = raw.suite
         self.steps, self._cache_step = 0, -1
         self._cache: tuple[np.ndarray, np.ndarray, np.ndarray, int] = (np.zeros(0),) * 3 + (0,)
         self._dig_copy = np.zeros(0, bool)
@@ -210,23 +220,25 @@ class GuaranteedObserver(gym.Wrapper):
         self._explored_all, self._clear_all = self._planes[0].view(np.int8), self._planes[1].view(np.bool_)
         self._dark_all, self._base, self._n = self._planes[2].view(np.bool_), np.zeros((3, m, m), np.uint8), 0
         self._xs, self._nys = np.array(g.xs, np.float64), np.array(-g.ys, np.float64)
-        # what :func:`.maps_jit.observe_step` reads and keeps (each reset), as the plain tuple of its fields
+        # what :func:`.observe_jit.observe_step` reads and keeps (each reset), as the plain tuple of its
+        # fields
         self._maps: tuple = ()
-        # the certified count and the grid's number of clear cells, kept by :func:`.maps_jit.observe_step`
+        # the certified count and the grid's number of clear cells, kept by :func:`.observe_jit.observe_step`
         self._counts = np.zeros(2, np.int64)
         self._img_shape, self._snap_shape = (self.n_channels, m, m), (3, *shape)
 
     # --- gymnasium API -------------------------------------------------------------------------------------
     def reset(self, **kwargs: Any) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         _, info = self.env.reset(**kwargs)
-        raw = self.env.unwrapped
+        raw, world = self._explore, self._world()
         truth = info["truth"]
-        self.grid_check(raw.world)
-        if self._reach_world is not raw.world or not self._in_reach(truth.pose):  # once per world and start
-            self.reachable = reachable_free(raw.world, self.grid, truth.pose)
+        self._suite = raw.suite
+        self.grid_check(world)
+        if self._reach_world is not world or not self._in_reach(truth.pose):  # once per world and start
+            self.reachable = reachable_free(world, self.grid, truth.pose)
             self.n_reachable = max(int(np.count_nonzero(self.reachable)), 1)
             self._planes[3] = self.reachable
-            self._reach_world = raw.world
+            self._reach_world = world
         b = self.obs_config.start_box
         p = truth.pose[:2]
         lo = np.maximum(p - b, np.array(self.grid.lo))
@@ -237,26 +249,37 @@ class GuaranteedObserver(gym.Wrapper):
         self._maps = tuple(map_context(sets, MapPlanes(*self._planes), self._base, self._xs, self._nys,
                                        self.obs_config.horizon))  # fmt: skip
         self.steps, self._cache_step = 0, -1
-        # ground truth over the cells of the certified coverage, the reachable free area (:mod:`.coverage`)
+        # ground truth over the cells of the certified coverage, the reachable free area
+        # (:mod:`digslam.envs.explore.coverage`)
         self.truth_coverage = Coverage.on_cells(self.reachable[::-1], self.grid.lo, self.grid.cell_size,
                                                 float(raw.suite.r_max.max()))  # fmt: skip
         self.truth_coverage.update(truth.pose, raw.suite, truth.ranges)
-        raw.measure_coverage_on(self.truth_coverage)  # the raw env updates it each step (its reward too)
-        self.monitor = (GuaranteeMonitor(raw.world, self.grid, coverage=(self.reachable, self.truth_coverage))
+        self.monitor = (GuaranteeMonitor(world, self.grid, coverage=(self.reachable, self.truth_coverage))
                         if self.obs_config.monitor else None)  # fmt: skip
         self._check(info)
         self._clear_count = self._certified_count()
         return self.observation(), self._obs_info(info)
 
     def step(self, action: Any) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
-        step = self.env._step(action, observe=False) if self._fast else self.env.step(action)
-        _, reward, terminated, truncated, info = step
+        if self._direct is not None:
+            _, terminated, truncated, info = self._direct.step_record(action)
+        else:
+            _, _, terminated, truncated, info = self.env.step(action)
+        truth = info["truth"]
+        reward = self.truth_coverage.update(truth.pose, self._suite, truth.ranges)
+        terminated = terminated or self.truth_coverage.fraction >= 1.0
         self.filter.update(info["record"])
         self.steps += 1
         if self.monitor is not None:
             self.monitor.check(self.filter, info["truth"], info["record"], self.steps)
         truncated = truncated or not self.filter.consistent
         return self.observation(), float(reward), terminated, truncated, self._obs_info(info)
+
+    def _world(self) -> World:
+        """The raw env's current world (ground truth; set by ``reset``)."""
+        if self._explore.world is None:
+            raise RuntimeError("call reset() first")
+        return self._explore.world
 
     # --- pieces ---------------------------------------------------------------------------------------------
     def _in_reach(self, pose: np.ndarray) -> bool:
@@ -275,7 +298,7 @@ class GuaranteedObserver(gym.Wrapper):
 
     def _sets(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
         """The filter's explored codes, clear and dark masks and certified cell count, once per step, with
-        the observation (:meth:`observation`): one compiled call (:func:`.maps_jit.observe_step`)
+        the observation (:meth:`observation`): one compiled call (:func:`.observe_jit.observe_step`)
         keeps the sets and the map's clear / penumbra / dark channels up to
         date on the cells the step touched (:meth:`OnlineDigSlam.take_touched`) and draws the pose-box channel
         and the state. Returns info's copies of the explored codes and the clear mask (empty ``(0, 0)`` arrays
@@ -301,15 +324,17 @@ class GuaranteedObserver(gym.Wrapper):
         return self._cache
 
     def _crop(self, img: np.ndarray) -> None:
-        """Channels 4-6: clear / penumbra / dark of the ``crop`` window centred on the pose box."""
+        """Channels ``Channel.CROP_CLEAR`` to ``Channel.CROP_DARK``: clear / penumbra / dark of the ``crop``
+        window centred on the pose box."""
         f, g = self.filter, self.grid
+        assert self.obs_config.crop is not None  # (called with a crop window only)
         k = max(int(math.ceil(self.obs_config.crop / g.cell_size[0])), 1)
         ctr = 0.5 * (f.pose_lo + f.pose_hi)
         rc = int(Grid.count_below(-g.ys, np.array([-ctr[1]]))[0]) - 1
         cc = int(Grid.count_below(g.xs, np.array([ctr[0]]))[0]) - 1
         a, b = rc - k // 2, cc - k // 2
         clear, dark = crop_window(self._clear_all, a, b, k, False), crop_window(self._dark_all, a, b, k, True)
-        fill_map(clear, dark, img, 4)
+        fill_map(clear, dark, img, Channel.CROP_CLEAR)
 
     def _certified_count(self) -> int:
         """Clear cells in the reachable free area (0 once the claims are withdrawn)."""
@@ -320,7 +345,7 @@ class GuaranteedObserver(gym.Wrapper):
         if not self.filter.consistent:  # claims withdrawn: everything is penumbra
             m = self.obs_config.map_size
             img = np.zeros((self.n_channels, m, m), dtype=np.uint8)
-            img[1] = 255
+            img[Channel.PENUMBRA] = 255
             return {"map": img, "state": np.zeros(N_STATE, dtype=np.float32)}
         self._sets()
         img, state = self._obs
@@ -340,7 +365,7 @@ class GuaranteedObserver(gym.Wrapper):
         return {"explored": explored, "dig": f.dig.free.copy(), "clear": clear}
 
     def _obs_info(self, info: dict[str, Any]) -> dict[str, Any]:
-        f = self.filter
+        f, t = self.filter, self.truth_coverage.fraction
         if f.consistent:
             explored, clear, _, n = self._sets()
             if self.obs_config.info_sets:
@@ -349,20 +374,19 @@ class GuaranteedObserver(gym.Wrapper):
                     "pose_box": np.array((f.pose_lo, f.pose_hi), np.float64),
                     "heading_box": np.array((f.heading_lo, f.heading_hi), np.float64),
                     "certified_coverage": n / self.n_reachable, "clear_area": n * self.cell_area,
-                    "true_coverage": self.truth_coverage.fraction, "consistent": True,
+                    "true_coverage": t, "coverage": t, "consistent": True,
                     "inconsistent_step": f.inconsistent_step, **self._extra_info}  # fmt: skip
         if self.obs_config.info_sets:
             info = {**info, **self.sets()}
         return {**info, "pose_box": np.full((2, 2), np.nan),
                 "heading_box": np.full(2, np.nan), "certified_coverage": 0 / self.n_reachable,
-                "clear_area": 0 * self.cell_area, "true_coverage": self.truth_coverage.fraction,
+                "clear_area": 0 * self.cell_area, "true_coverage": t, "coverage": t,
                 "consistent": False, "inconsistent_step": f.inconsistent_step,
                 **self._extra_info}  # fmt: skip
 
 
 __all__ = [
     "GuaranteedObserver",
-    "N_STATE",
     "make_grid",
     "reachable_free",
 ]

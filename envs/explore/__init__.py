@@ -8,40 +8,16 @@ May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.record.mission`
 :mod:`digslam.envs.config`; gymnasium, numpy.
 """
 
-from .coverage import (
-    Coverage,
-)
-from .coverage_jit import (
-    BLOCK,
-    NB,
-    cone_table,
-    cover_step,
-    pseudo_angle,
-    todo_blocks,
-)
-from .env import (
-    ExploreEnv,
-)
-from .episode import (
-    Episode,
-    record_episode,
-    replay,
-)
-from .truth import (
-    GroundTruth,
-)
+from .coverage import Coverage
+from .env import ExploreEnv
+from .episode import Episode, record_episode, replay
+from .truth import GroundTruth
 
 __all__ = [
-    "BLOCK",
     "Coverage",
     "Episode",
     "ExploreEnv",
     "GroundTruth",
-    "NB",
-    "cone_table",
-    "cover_step",
-    "pseudo_angle",
     "record_episode",
     "replay",
-    "todo_blocks",
 ]

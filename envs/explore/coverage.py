@@ -11,12 +11,13 @@ Two areas are in use, and each figure says which:
   cells of ``coverage_resolution`` entirely free in the exact raster, *all* of the world's free area,
   reachable or not;
 * :meth:`Coverage.on_cells` over the **reachable free area** of the certified-coverage environments
-  (:func:`.observer_wrapper.reachable_free`: the observer grid's cells entirely free in the exact raster and
-  connected to the start). ``info["true_coverage"]`` of :class:`.observer_wrapper.GuaranteedObserver` is
-  this one: the share of those cells whose centre was truly sensed, over the same cells as the certified
-  coverage (clear cells among them over their number). A clear cell is proved free and certainly sensed, so
-  its centre was truly sensed: *certified coverage <= ground-truth coverage* is an invariant (checked by
-  ``monitor=True``, :mod:`.monitor`).
+  (:func:`~digslam.envs.dig_coverage.wrapper.reachable_free`: the observer grid's cells entirely free in
+  the exact raster and connected to the start), kept by the wrapper itself. ``info["true_coverage"]`` of
+  :class:`~digslam.envs.dig_coverage.wrapper.GuaranteedObserver` is this one: the share of those cells
+  whose centre was truly sensed, over the same cells as the certified coverage (clear cells among them over
+  their number). A clear cell is proved free and certainly sensed, so its centre was truly sensed:
+  *certified coverage <= ground-truth coverage* is an invariant (checked by ``monitor=True``,
+  :mod:`digslam.envs.dig_coverage.monitor`).
 """
 
 from __future__ import annotations

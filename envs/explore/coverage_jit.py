@@ -11,7 +11,7 @@ box of its sector only, and decides each cell there through a lookup table of ps
 search in the bins that hold a bound), keeping the cells whose interval it is. It visits only the cells
 still to cover: it keeps them in a raster beside ``seen`` with their counts per block of ``BLOCK x BLOCK``
 cells, and skips the blocks with none left or none within reach, and the whole step when no cell left lies
-within reach. Same decisions, bit for bit, as the kernel without block skipping it replaced (the oracle
+within reach. Same decisions, bit for bit, as the kernel without block skipping (the oracle
 ``tests/coverage_oracle.py``), and as the numpy brute force of ``tests/envs/explore/test_coverage.py``
 except for cell centres within rounding of a cone edge.
 

@@ -4,9 +4,9 @@ Action: normalised ``(v, omega)`` in ``[-1, 1]^2``: the commanded body-frame spe
 (dict): range intervals ``ranges (n, 2)`` (``[r_max, top]`` where no echo), ``no_echo (n,)``,
 ``odometry (3, 2)`` (intervals of the forward speed, the leftward velocity and the yaw rate over the step
 just ended) and ``heading (2,)`` (compass interval, shifted by a multiple of 2 pi into about ``[-pi, pi]``).
-Reward: the newly and truly sensed free area (m^2). ``info`` holds the
+Reward: the newly and truly sensed free area (m^2; none with ``measure_coverage=False``). ``info`` holds the
 :class:`~digslam.observer.record.mission.MissionRecord` under ``"record"`` and the
-:class:`~digslam.envs.explore.episode.GroundTruth` under ``"truth"``.
+:class:`~digslam.envs.explore.truth.GroundTruth` under ``"truth"``.
 
 Record convention (record ``j`` is the one returned at time ``t_j``; ``j = 0`` by ``reset``):
 
@@ -36,40 +36,28 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
-from gymnasium.envs.registration import EnvSpec
 
 from digslam.envs.config import ExploreConfig
 from digslam.envs.explore.coverage import Coverage
 from digslam.envs.explore.truth import GroundTruth
 from digslam.envs.sim.arc_jit import exact_duration
-from digslam.envs.sim.generators import GENERATORS, WorldGenerator
+from digslam.envs.sim.generators import Generator, make_generator
 from digslam.envs.sim.noise_jit import obs_kernel
 from digslam.envs.sim.robot import RobotSim
 from digslam.envs.sim.sensors import SensorSuite, record_step
 from digslam.envs.sim.world import World
 from digslam.observer.record.mission import MissionRecord
 
+if TYPE_CHECKING:  # pygame is imported on use only
+    from digslam.envs.sim.render import Renderer
+
 #: The largest ``|a_i|`` of an action (normalised ``v``, ``omega``) accepted, then clipped to ``[-1, 1]``.
 _ACTION_TOL = 1.0 + 1e-6
-
-
-def _generator(cfg: ExploreConfig) -> WorldGenerator:
-    if cfg.world == "file":
-        return GENERATORS["file"](cfg.map_path, size=cfg.world_size)  # type: ignore[call-arg]
-    if cfg.world == "rocks":
-        return GENERATORS["rocks"](size=cfg.world_size, n=cfg.n_obstacles)  # type: ignore[call-arg]
-    if cfg.world == "room":
-        return GENERATORS["room"](size=cfg.world_size, jitter=cfg.room_jitter)  # type: ignore[call-arg]
-    if cfg.world == "mixed":  # each of the suite's generators with the settings it gets on its own
-        each = tuple(_generator(replace(cfg, world=w)) for w in ("room", "rocks", "caves", "rooms"))
-        return GENERATORS["mixed"](each, size=cfg.world_size)  # type: ignore[call-arg]
-    return GENERATORS[cfg.world](size=cfg.world_size)
 
 
 class ExploreEnv(gym.Env):
@@ -78,44 +66,25 @@ class ExploreEnv(gym.Env):
     Args:
         config: An :class:`ExploreConfig`, a mapping, or None for the defaults.
         render_mode: ``"rgb_array"``, ``"human"`` or None.
+        measure_coverage: Keep the ground-truth coverage (:attr:`coverage`) behind the reward, the
+            termination and ``info["coverage"]`` (True). False keeps none: the reward is 0, no episode
+            terminates and ``info`` has no ``"coverage"``; for a wrapper that measures the ground truth
+            on an area of its own (e.g. the certified-coverage envs, which build their raw env so), one
+            compiled coverage pass a step fewer.
         **overrides: Config fields overriding ``config`` (unknown keys raise ``ValueError``).
+
+    Besides the Gymnasium API, :meth:`step_record` is the step without the observation, for a wrapper that
+    replaces it.
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
-    _spec: EnvSpec | None = None
-    _spec_owner: Any = None  # the env an id builds around this raw env (:meth:`built_inside`)
-
-    @property
-    def spec(self) -> EnvSpec | None:  # type: ignore[override]
-        """This raw env's own spec: that of ``gym.make`` for the ``Explore`` ids, None when built directly;
-        inside an env that an id makes around it (:meth:`built_inside`), ``digslam/Explore-v0`` with this
-        env's config, never the outer id (the outer env holds that)."""
-        return self._spec
-
-    @spec.setter
-    def spec(self, value: EnvSpec | None) -> None:
-        # ``gym.make`` writes the spec of the id it made onto ``env.unwrapped``, this raw env; when that id
-        # made the env around it, the spec is the outer env's
-        if self._spec_owner is not None:
-            self._spec_owner.spec = value
-        else:
-            self._spec = value
-
-    def built_inside(self, owner: Any) -> None:
-        """Make this raw env the base of ``owner`` (an env with a settable ``spec``: the
-        ``digslam/DigCoverage-*`` ids' :class:`~digslam.envs.dig_coverage.env.DigCoverageEnv`): its spec
-        becomes ``digslam/Explore-v0`` with its own config (so ``spec.make()`` builds an equal raw env, in
-        any of its render modes), and the id's spec that ``gym.make`` then writes onto ``owner.unwrapped``
-        goes to ``owner``."""
-        self._spec = EnvSpec(id="digslam/Explore-v0", entry_point="digslam.envs.explore.env:ExploreEnv",
-                             kwargs={"config": self.config.to_dict()}, max_episode_steps=None,
-                             order_enforce=False, disable_env_checker=True)  # fmt: skip
-        self._spec_owner = owner
 
     def __init__(
         self,
         config: ExploreConfig | Mapping[str, Any] | None = None,
         render_mode: str | None = None,
+        *,
+        measure_coverage: bool = True,
         **overrides: Any,
     ) -> None:
         if isinstance(config, ExploreConfig):
@@ -127,13 +96,16 @@ class ExploreEnv(gym.Env):
                 f"render_mode: must be one of {self.metadata['render_modes']}, got {render_mode!r}"
             )
         self.config, self.render_mode = cfg, render_mode
+        self.measure_coverage = bool(measure_coverage)
         self.suite = SensorSuite.from_config(cfg)
-        self.generator = _generator(cfg)
+        self.generator: Generator = make_generator(cfg)
         n, nz = self.suite.n, cfg.noise
         self._top = float(self.suite.r_max.max() + 2 * nz.range + 1.0)
         s_top = 10 * cfg.max_speed + 2 * nz.speed + 1.0
         self._odo_top = np.array([[s_top], [s_top], [10 * cfg.max_yaw_rate + 2 * nz.yaw_rate + 1.0]])
         self.action_space = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
+        hb = spaces.Box(-math.pi - 1.0 - 2 * nz.heading, math.pi + 1.0 + 2 * nz.heading, shape=(2,),
+                        dtype=np.float64)  # fmt: skip
         self.observation_space = spaces.Dict(
             {
                 "ranges": spaces.Box(0.0, self._top, shape=(n, 2), dtype=np.float64),
@@ -141,22 +113,16 @@ class ExploreEnv(gym.Env):
                 "odometry": spaces.Box(
                     -np.repeat(self._odo_top, 2, 1), np.repeat(self._odo_top, 2, 1), dtype=np.float64
                 ),
-                "heading": spaces.Box(
-                    -math.pi - 1.0 - 2 * nz.heading,
-                    math.pi + 1.0 + 2 * nz.heading,
-                    shape=(2,),
-                    dtype=np.float64,
-                ),
+                "heading": hb,
             }
         )
         self._odo_tops = (float(self._odo_top[0, 0]), float(self._odo_top[2, 0]))
-        hb = self.observation_space["heading"]
         self._heading_box = (float(hb.low[0]), float(hb.high[0]))
         self.world: World | None = None
         self._world_seed: int | None = None
         self.sim: RobotSim | None = None
         self.coverage: Coverage | None = None
-        self._renderer: Any = None
+        self._renderer: Renderer | None = None
 
     # --- gymnasium API -------------------------------------------------------------------------------------
     def reset(
@@ -187,10 +153,11 @@ class ExploreEnv(gym.Env):
             pose = self.world.sample_reachable_pose(self.np_random, 1.5 * cfg.robot_radius + skin)
         self.sim = RobotSim(self.world, cfg.robot_radius, pose, cfg.max_force, cfg.max_torque, skin,
                             cfg.dynamics, max_speed=cfg.max_speed, max_yaw_rate=cfg.max_yaw_rate)  # fmt: skip
-        self.coverage = Coverage(self.world, cfg.coverage_resolution, float(self.suite.r_max.max()))
         self.t, self.path = 0.0, [pose[:2].copy()]
         record, truth = self._sense(0)
-        self.coverage.update(truth.pose, self.suite, truth.ranges)
+        if self.measure_coverage:
+            self.coverage = Coverage(self.world, cfg.coverage_resolution, float(self.suite.r_max.max()))
+            self.coverage.update(truth.pose, self.suite, truth.ranges)
         self._last = record
         return self._obs(record), self._info(record, truth)
 
@@ -198,13 +165,15 @@ class ExploreEnv(gym.Env):
         """One step of ``dt`` under the normalised command ``action = (v, omega)`` in ``[-1, 1]²``: the
         Gymnasium ``(observation, reward, terminated, truncated, info)``, with the step's record and ground
         truth in ``info``."""
-        return self._step(action)
+        reward, terminated, truncated, info = self.step_record(action)
+        return self._obs(info["record"]), reward, terminated, truncated, info
 
-    def _step(
-        self, action: np.ndarray, observe: bool = True
-    ) -> tuple[dict[str, np.ndarray] | None, float, bool, bool, dict[str, Any]]:
-        """:meth:`step`; with ``observe=False`` the raw observation is not built and None stands in its place
-        (the internal fast path of the observer wrapper, which hands the agent its own observation)."""
+    def step_record(self, action: np.ndarray) -> tuple[float, bool, bool, dict[str, Any]]:
+        """:meth:`step` without building the observation: ``(reward, terminated, truncated, info)``, the
+        step's :class:`~digslam.observer.record.mission.MissionRecord` in ``info["record"]`` (what the
+        observation is made of). For a wrapper that replaces the observation with its own, such as
+        :class:`~digslam.envs.dig_coverage.wrapper.GuaranteedObserver`; the env's state moves exactly as
+        under :meth:`step`."""
         if self.sim is None:
             raise RuntimeError("step: call reset() before step()")
         v, w = self._check_action(action)
@@ -219,8 +188,7 @@ class ExploreEnv(gym.Env):
         reward = self._reward(truth)
         if self.render_mode == "human":
             self.render()
-        obs = self._obs(record) if observe else None
-        return obs, reward, self._terminated(), False, self._info(record, truth)
+        return reward, self._terminated(), False, self._info(record, truth)
 
     def render(self) -> np.ndarray | None:
         if self.render_mode is None:
@@ -230,23 +198,12 @@ class ExploreEnv(gym.Env):
             from digslam.envs.sim.render import Renderer
 
             self._renderer = Renderer(self.render_mode, self.metadata["render_fps"])
-        return self._renderer.draw(self)
+        return self._renderer.draw(self, self._last)
 
     def close(self) -> None:
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
-
-    def measure_coverage_on(self, coverage: Coverage) -> None:
-        """Measure the ground-truth coverage (the reward, ``info["coverage"]`` and termination) on
-        ``coverage``'s cells until the next reset, instead of the world's whole free raster.
-
-        The certified-coverage wrapper passes the reachable free cells of its grid (already updated with
-        the reset's readings), so that one compiled update a step serves both the raw env and the wrapper's
-        ``true_coverage``, and both speak of the same area as the certified coverage."""
-        if self.sim is None:
-            raise RuntimeError("measure_coverage_on: call reset() first")
-        self.coverage = coverage
 
     # --- pieces of step ------------------------------------------------------------------------------------
     def _check_action(self, action: np.ndarray) -> tuple[float, float]:
@@ -268,6 +225,8 @@ class ExploreEnv(gym.Env):
         ranges, bounds = suite.sense(self.world, pose, sim.pose_error)  # true_ranges, range_bounds
         record = record_step(self.t, suite, bounds, sim.hulls, pose[2], sim.measured, self.config.noise,
                              self.np_random)  # fmt: skip
+        states: np.ndarray | None
+        taus: np.ndarray | None
         if sim.dynamics == "pymunk":
             states, taus = sim.states, sim.taus  # fresh arrays each step (the durations shared, read-only)
             if not len(taus):  # at reset: at rest, S + 1 copies of the start pose
@@ -282,15 +241,16 @@ class ExploreEnv(gym.Env):
         return record, truth
 
     def _reward(self, truth: GroundTruth) -> float:
-        assert self.coverage is not None
+        if self.coverage is None:  # not measured (``measure_coverage=False``)
+            return 0.0
         return self.coverage.update(truth.pose, self.suite, truth.ranges)
 
     def _terminated(self) -> bool:
-        assert self.coverage is not None
-        return self.coverage.fraction >= 1.0
+        return self.coverage is not None and self.coverage.fraction >= 1.0
 
     def _info(self, record: MissionRecord, truth: GroundTruth) -> dict[str, Any]:
-        assert self.coverage is not None
+        if self.coverage is None:
+            return {"record": record, "truth": truth, "bumps": int(truth.bumps_total)}
         return {
             "record": record,
             "truth": truth,

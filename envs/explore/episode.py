@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass, fields
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 
 from digslam.envs.config import ExploreConfig
@@ -30,14 +31,14 @@ class Episode:
 
     def save(self, path: str | Path) -> None:
         """Save to ``.npz`` (the config as JSON, records and truth under prefixes)."""
-        np.savez(
-            path,
-            config=np.array(json.dumps(asdict(self.config))),
-            seed=np.array(self.seed),
-            actions=self.actions,
+        arrays: dict[str, Any] = {
+            "config": np.array(json.dumps(self.config.to_dict())),
+            "seed": np.array(self.seed),
+            "actions": self.actions,
             **self.records.to_arrays(),
             **{"truth_" + k: v for k, v in self.truth.as_dict().items()},
-        )
+        }
+        np.savez(path, **arrays)
 
     @staticmethod
     def load(path: str | Path) -> Episode:
@@ -52,7 +53,8 @@ class Episode:
             cfg.update(room_jitter=0.0, start_rule="origin")
         if cfg.get("start") is not None:
             cfg["start"] = tuple(cfg["start"])
-        truth = GroundTruth(**{f.name: data.get("truth_" + f.name) for f in fields(GroundTruth)})
+        saved: dict[str, Any] = {f.name: data.get("truth_" + f.name) for f in fields(GroundTruth)}
+        truth = GroundTruth(**saved)
         return Episode(
             ExploreConfig.from_dict(cfg),
             int(data["seed"]),
@@ -62,8 +64,11 @@ class Episode:
         )
 
 
-def record_episode(env: Any, seed: int, actions: np.ndarray) -> Episode:
+def record_episode(env: gym.Env, seed: int, actions: np.ndarray) -> Episode:
     """Run ``env`` (an ``ExploreEnv``, possibly wrapped) from ``reset(seed)`` through ``actions``."""
+    raw = env.unwrapped
+    if not isinstance(raw, ExploreEnv):
+        raise TypeError(f"env: must be an ExploreEnv, possibly wrapped; got {type(raw).__name__} below")
     actions = np.asarray(actions, dtype=np.float32).reshape(-1, 2)
     _, info = env.reset(seed=seed)
     recs, truths = [info["record"]], [info["truth"]]
@@ -74,7 +79,7 @@ def record_episode(env: Any, seed: int, actions: np.ndarray) -> Episode:
         if terminated or truncated:
             break
     return Episode(
-        env.unwrapped.config,
+        raw.config,
         int(seed),
         actions[: len(recs) - 1],
         MissionRecord.stack(recs),

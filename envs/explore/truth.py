@@ -100,7 +100,7 @@ class GroundTruth:
             for a, b in zip(self.as_dict().values(), other.as_dict().values(), strict=True)
         )
 
-    __hash__ = None  # type: ignore[assignment]
+    __hash__ = None  # type: ignore[assignment]  # unhashable (arrays, compared by value): object declares it
 
     @staticmethod
     def stack(items: list[GroundTruth]) -> GroundTruth:

@@ -14,164 +14,41 @@ May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.record.mission`
 numpy, scipy, pymunk, pygame (on use). No gymnasium.
 """
 
-from .arc_jit import (
-    advance,
-    arc,
-    arc_bounded,
-    arc_move,
-    exact_duration,
-    yaw_rate_bounds,
-)
-from .dynamics_jit import (
-    step_bounds,
-    substep_clear,
-    substep_times,
-)
 from .generators import (
+    BENCHMARK,
     GENERATORS,
     THESIS_ROOM,
     Caves,
     FileMap,
+    Generator,
     Mixed,
     RockField,
     RoomsCorridors,
     ThesisRoom,
     WorldGenerator,
+    make_generator,
 )
-from .geometry import (
-    Edges,
-    edge_bboxes,
-    point_edge_distance,
-    point_free,
-    rings_to_edges,
-    sector_distance,
-)
-from .geometry_jit import (
-    edge_boxes,
-    edge_near,
-    points_edges_kernel,
-    sector_bounds_kernel,
-    sector_kernel,
-    segment_distance,
-)
-from .missions import (
-    THESIS_LOOP,
-    loop_mission,
-)
-from .noise import (
-    measure,
-    outliers,
-)
-from .noise_jit import (
-    MEASURE_LATERAL,
-    MEASURE_MEAN,
-    MODEL_CODES,
-    RecordModel,
-    noise_kernel,
-    obs_kernel,
-    record_kernel,
-)
-from .raster import (
-    cell_centres,
-    grid_shape,
-    rasterize,
-)
-from .render import (
-    FREE,
-    MIXED,
-    Renderer,
-)
-from .robot import (
-    FRACTIONS,
-    ROBOT_FRICTION,
-    ROBOT_TYPE,
-    SWEEP_POINTS,
-    WALL_FRICTION,
-    WALL_TYPE,
-    RobotSim,
-)
-from .robot_jit import (
-    robot_step_kernel,
-)
-from .sensors import (
-    Hull,
-    SensorSuite,
-    measure_step,
-    record_step,
-)
-from .tracing import (
-    chain_rings,
-    marching_squares,
-    mask_edges,
-    smooth_noise,
-)
-from .world import (
-    World,
-)
+from .missions import THESIS_LOOP, loop_mission
+from .robot import RobotSim
+from .sensors import SensorSuite
+from .world import World
 
 __all__ = [
+    "BENCHMARK",
     "Caves",
-    "Edges",
-    "FRACTIONS",
-    "FREE",
     "FileMap",
-    "Mixed",
     "GENERATORS",
-    "Hull",
-    "MIXED",
-    "MEASURE_LATERAL",
-    "MEASURE_MEAN",
-    "MODEL_CODES",
-    "ROBOT_TYPE",
-    "ROBOT_FRICTION",
-    "RecordModel",
-    "Renderer",
+    "Generator",
+    "Mixed",
     "RobotSim",
     "RockField",
     "RoomsCorridors",
-    "SWEEP_POINTS",
     "SensorSuite",
     "THESIS_LOOP",
     "THESIS_ROOM",
     "ThesisRoom",
-    "WALL_FRICTION",
-    "WALL_TYPE",
     "World",
     "WorldGenerator",
-    "advance",
-    "arc",
-    "arc_bounded",
-    "arc_move",
-    "cell_centres",
-    "chain_rings",
-    "edge_bboxes",
-    "edge_boxes",
-    "edge_near",
-    "exact_duration",
-    "grid_shape",
     "loop_mission",
-    "marching_squares",
-    "mask_edges",
-    "measure",
-    "measure_step",
-    "record_step",
-    "noise_kernel",
-    "obs_kernel",
-    "outliers",
-    "point_edge_distance",
-    "point_free",
-    "points_edges_kernel",
-    "rasterize",
-    "record_kernel",
-    "rings_to_edges",
-    "robot_step_kernel",
-    "sector_bounds_kernel",
-    "sector_distance",
-    "sector_kernel",
-    "segment_distance",
-    "smooth_noise",
-    "step_bounds",
-    "substep_clear",
-    "substep_times",
-    "yaw_rate_bounds",
+    "make_generator",
 ]

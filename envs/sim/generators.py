@@ -1,18 +1,29 @@
-"""Seeded world generators. Each subclasses :class:`WorldGenerator` and overrides one hook, ``_gen_world``.
+"""Seeded world generators, and the one registry that names them (:data:`GENERATORS`).
 
-Generators build worlds in the frame ``[-size, size]^2`` and keep a clear disc of radius ``keep_clear``
-around the origin so that the default start pose ``(0, 0)`` is free.
+A generator is anything with a ``frame`` and a ``generate(seed)`` that builds a world from a seed
+(:class:`Generator`). Those of the registry subclass :class:`WorldGenerator` and override one hook,
+``_gen_world``; each builds itself from an env config (:meth:`WorldGenerator.from_config`), and
+:func:`make_generator` builds the one a config names (``config.world``). They build worlds in the frame
+``[-size, size]^2`` and keep a clear disc of radius ``keep_clear`` around the origin so that the default
+start pose ``(0, 0)`` is free.
+
+>>> sorted(GENERATORS), BENCHMARK
+(['caves', 'file', 'mixed', 'rocks', 'room', 'rooms'], ('room', 'rocks', 'caves', 'rooms'))
 """
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
 from digslam.envs.sim.tracing import marching_squares, mask_edges, smooth_noise
 from digslam.envs.sim.world import World
+
+if TYPE_CHECKING:  # (only the config's fields are read)
+    from digslam.envs.config import ExploreConfig
 
 # Thesis Fig. 6.10: a polygonal room in the frame [-10, 10]^2 made of segments (shape redrawn, not traced).
 THESIS_ROOM = np.array(
@@ -34,6 +45,16 @@ THESIS_ROOM = np.array(
         (-9.3, -3.0),
     ]
 )
+
+
+class Generator(Protocol):
+    """What an env needs of a world generator: the frame its worlds lie in, and one world per seed (the same
+    seed, the same world)."""
+
+    @property
+    def frame(self) -> tuple[float, float, float, float]: ...
+
+    def generate(self, seed: int | None = None) -> World: ...
 
 
 class WorldGenerator:
@@ -58,6 +79,12 @@ class WorldGenerator:
         s = self.size
         return (-s, -s, s, s)
 
+    @classmethod
+    def from_config(cls, cfg: ExploreConfig) -> WorldGenerator:
+        """The generator with the settings of ``cfg`` (:class:`~digslam.envs.config.ExploreConfig`):
+        ``world_size``, and the fields of the subclass's own world."""
+        return cls(size=cfg.world_size)
+
     def generate(self, seed: int | None = None) -> World:
         """Build a world from ``seed`` (same seed, same world)."""
         return self._gen_world(np.random.default_rng(seed))
@@ -79,6 +106,11 @@ class ThesisRoom(WorldGenerator):
         super().__init__(size, **kw)
         self.jitter = float(jitter)
 
+    @classmethod
+    def from_config(cls, cfg: ExploreConfig) -> WorldGenerator:
+        """The room of ``world_size``, jittered by ``room_jitter``."""
+        return cls(size=cfg.world_size, jitter=cfg.room_jitter)
+
     def _gen_world(self, rng: np.random.Generator) -> World:
         ring = THESIS_ROOM * (self.size / 10.0)
         ring = ring + rng.uniform(-self.jitter, self.jitter, ring.shape)
@@ -97,6 +129,11 @@ class RockField(WorldGenerator):
         if n < 0:
             raise ValueError(f"n: must be >= 0, got {n!r}")
         self.n, self.radius = int(n), (float(radius[0]), float(radius[1]))
+
+    @classmethod
+    def from_config(cls, cfg: ExploreConfig) -> WorldGenerator:
+        """``n_obstacles`` rocks in the frame of ``world_size``."""
+        return cls(size=cfg.world_size, n=cfg.n_obstacles)
 
     def _gen_world(self, rng: np.random.Generator) -> World:
         s, (rmin, rmax) = self.size, self.radius
@@ -241,6 +278,13 @@ class FileMap(WorldGenerator):
         if not self.path.exists():
             raise ValueError(f"map_path: file {str(self.path)!r} does not exist")
 
+    @classmethod
+    def from_config(cls, cfg: ExploreConfig) -> WorldGenerator:
+        """The map of ``map_path`` stretched over the frame of ``world_size``."""
+        if cfg.map_path is None:
+            raise ValueError("map_path: is required when world='file'")
+        return cls(cfg.map_path, size=cfg.world_size)
+
     def _gen_world(self, rng: np.random.Generator) -> World:
         suffix = self.path.suffix.lower()
         if suffix == ".json":
@@ -264,9 +308,10 @@ class FileMap(WorldGenerator):
 
 
 class Mixed(WorldGenerator):
-    """Each level from one of ``generators`` (room, rocks, caves, rooms by default), drawn from the level's
-    seed (uniformly), then built by that generator from the same random stream: one env id over every
-    generator of the coverage suite, for training across them. The same seed gives the same world.
+    """Each level from one of ``generators`` (those of :data:`BENCHMARK` by default: room, rocks, caves,
+    rooms), drawn from the level's seed (uniformly), then built by that generator from the same random
+    stream: one env id over every generator of the coverage suite, for training across them. The same seed
+    gives the same world.
 
     Args:
         generators: The generators to draw from (built by the caller with their own settings).
@@ -276,16 +321,21 @@ class Mixed(WorldGenerator):
 
     def __init__(self, generators: tuple[WorldGenerator, ...] = (), size: float = 10.0, **kw: float) -> None:
         super().__init__(size, **kw)
-        self.generators = tuple(generators) or (ThesisRoom(size), RockField(size), Caves(size),
-                                                RoomsCorridors(size))  # fmt: skip
+        self.generators = tuple(generators) or tuple(GENERATORS[w](size) for w in BENCHMARK)
         for g in self.generators:
             if g.frame != self.frame:
                 raise ValueError(f"generators: {g.name} has frame {g.frame}, expected {self.frame}")
+
+    @classmethod
+    def from_config(cls, cfg: ExploreConfig) -> WorldGenerator:
+        """The generators of :data:`BENCHMARK`, each with the settings of ``cfg`` it gets on its own."""
+        return cls(tuple(GENERATORS[w].from_config(cfg) for w in BENCHMARK), size=cfg.world_size)
 
     def _gen_world(self, rng: np.random.Generator) -> World:
         return self.generators[int(rng.integers(len(self.generators)))]._gen_world(rng)
 
 
+#: The generators by the name an env config gives them (``ExploreConfig.world``): the one registry.
 GENERATORS: dict[str, type[WorldGenerator]] = {
     "room": ThesisRoom,
     "rocks": RockField,
@@ -298,15 +348,29 @@ GENERATORS: dict[str, type[WorldGenerator]] = {
 BENCHMARK: tuple[str, ...] = ("room", "rocks", "caves", "rooms")
 
 
+def make_generator(cfg: ExploreConfig) -> WorldGenerator:
+    """The generator that ``cfg.world`` names in :data:`GENERATORS`, built with the settings of ``cfg``
+    (:meth:`WorldGenerator.from_config`).
+
+    Raises:
+        ValueError: ``cfg.world`` names no generator.
+    """
+    if cfg.world not in GENERATORS:
+        raise ValueError(f"world: must be one of {sorted(GENERATORS)}, got {cfg.world!r}")
+    return GENERATORS[cfg.world].from_config(cfg)
+
+
 __all__ = [
     "BENCHMARK",
     "Caves",
     "FileMap",
     "GENERATORS",
+    "Generator",
     "Mixed",
     "RockField",
     "RoomsCorridors",
     "THESIS_ROOM",
     "ThesisRoom",
     "WorldGenerator",
+    "make_generator",
 ]

@@ -9,7 +9,7 @@ a circular sector of any half-aperture in ``(0, pi]``. Since a sector is star-sh
 the nearest obstacle point in the sector whenever the apex is free. It is exact (no ray fan): per edge, the
 minimum of the convex distance function over the edge's part inside the sector is reached at the foot of
 the perpendicular, at an endpoint inside the sector, or where the edge crosses a boundary ray. The distance
-routines run compiled (:mod:`.geometry_jit`); the numpy versions they replaced are the test oracles of
+routines run compiled (:mod:`.geometry_jit`); numpy versions of them are the test oracles of
 ``tests/envs/sim/test_kernels.py``.
 """
 
@@ -53,8 +53,8 @@ def point_free(points: np.ndarray, edges: Edges, chunk: int = 2048) -> np.ndarra
 def point_edge_distance(points: np.ndarray, edges: Edges) -> np.ndarray:
     """Distance from each point to the nearest edge, shape ``(N,)`` (``inf`` with no edges).
 
-    Compiled (:func:`.geometry_jit.points_edges_kernel`); the numpy version it replaced is the test oracle
-    of ``tests/envs/sim/test_kernels.py``.
+    Compiled (:func:`.geometry_jit.points_edges_kernel`); a numpy version of it is the test oracle of
+    ``tests/envs/sim/test_kernels.py``.
     """
     pts = np.ascontiguousarray(np.atleast_2d(np.asarray(points, dtype=np.float64)))
     e = np.ascontiguousarray(edges, dtype=np.float64).reshape(-1, 4)

@@ -4,8 +4,8 @@ Each kernel loops over the world's edges in machine code (:func:`digslam.observe
 with the
 bounding-box pre-filter fused in (an edge whose box lies farther than
 ``reach`` from the point is skipped; ``reach = inf`` keeps every edge). :func:`sector_kernel` and
-:func:`points_edges_kernel` compute float64 values, with the same formulas as the numpy code they replace
-(kept as test oracles in ``tests/envs/sim/test_kernels.py``):
+:func:`points_edges_kernel` compute float64 values, with the same formulas as the numpy versions that are
+their test oracles in ``tests/envs/sim/test_kernels.py``:
 
 * :func:`sector_kernel` -- the sonar distance of thesis Eq. (4.22), ``d = inf {d | f(S_1, d) ∩ not M ≠ ∅}``:
   the nearest edge point inside each circular sector (exact, no ray fan): per edge,
@@ -272,7 +272,7 @@ def sector_bounds_kernel(x: float, y: float, th: float, alpha: np.ndarray, gamma
     """Rigorous bounds ``out[s] = (lo, hi)``, ``lo <= d_s <= hi``, of the true distance ``d_s`` from the true
     position to the nearest obstacle point of sector ``s`` (thesis Eq. 4.22), written in place.
 
-    The true heading is ``th`` exactly (:mod:`.arc`); the true position lies within ``perr`` of ``(x, y)``
+    The true heading is ``th`` exactly (:mod:`.arc_jit`); the true position lies within ``perr`` of ``(x, y)``
     in each coordinate (the simulator's accumulated bound). Three effects are bounded:
 
     * **The pose error.** A cone is not Lipschitz in its apex (an obstacle corner on a boundary ray enters

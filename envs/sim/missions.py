@@ -11,11 +11,11 @@ its heading moves linearly from ``ψ_k`` to ``ψ_{k+1}``. The records follow the
 * ``range[k]`` bounds the exact sonar / omnidirectional distances (:class:`~.sensors.SensorSuite`) at
   the true pose ``k``.
 
-The truth is the chain of exact arcs of :mod:`.arc` (one function for the whole project): each slice lasts
+The truth is the chain of exact arcs of :mod:`.arc_jit` (one function for the whole project): each slice lasts
 exactly ``t_{k+1} - t_k`` (consecutive float times), its heading ``fl(ψ_k + ω τ)`` is the true heading, and
-the position carries the proved, accumulated error bound of :func:`.arc.arc_move`. The records contain the
+the position carries the proved, accumulated error bound of :func:`.arc_jit.arc_move`. The records contain the
 exact truth, floating point included: the speed is exact, the yaw rate is outward-rounded
-(:func:`.arc.yaw_rate_bounds`) and the ranges are rigorous bounds around the true pose
+(:func:`.arc_jit.yaw_rate_bounds`) and the ranges are rigorous bounds around the true pose
 (:meth:`~.sensors.SensorSuite.range_bounds`); no tolerance is chosen by hand.
 
 >>> rec, truth = loop_mission(duration=2.0, seed=0)

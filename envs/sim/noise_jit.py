@@ -1,7 +1,7 @@
 """Compiled kernels of the bounded noise (:mod:`.noise`) and of the step's record (:mod:`.sensors`).
 
-The random draws stay in numpy (``rng.uniform``, or ``rng.random`` mapped to the same values, in the same
-order as before, so runs are reproducible);
+The random draws stay in numpy (``rng.uniform``, or ``rng.random`` mapped to the same values, in a fixed
+order, so runs are reproducible);
 the kernels turn them into measured values and intervals. Every interval contains the truth exactly:
 
 * ``uniform`` / ``biased``: ``[m - b, m + b]`` widened by 4 ulps of ``max(|m|, b)``;

@@ -7,17 +7,34 @@
 from __future__ import annotations
 
 import os
-from typing import Any
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 import pygame  # noqa: E402
 
-from digslam.envs.sim.raster import FREE, MIXED
+from digslam.observer.record.mission import MissionRecord
+
+if TYPE_CHECKING:  # (types only)
+    from digslam.envs.config import ExploreConfig
+    from digslam.envs.sim.robot import RobotSim
+    from digslam.envs.sim.sensors import SensorSuite
+    from digslam.envs.sim.world import World
 
 SIZE = 512
 _COLOURS = np.array([[250, 250, 250], [60, 60, 70], [150, 150, 160]], dtype=np.uint8)  # free, occupied, mixed
+
+
+class Scene(Protocol):
+    """What :meth:`Renderer.draw` reads of an env (an :class:`~digslam.envs.explore.env.ExploreEnv`): the
+    world, the path so far, the robot, its sensors and its configuration."""
+
+    world: World | None
+    path: list[np.ndarray]
+    sim: RobotSim | None
+    suite: SensorSuite
+    config: ExploreConfig
 
 
 class Renderer:
@@ -26,7 +43,7 @@ class Renderer:
     def __init__(self, mode: str, fps: int) -> None:
         self.mode, self.fps = mode, fps
         self._bg: pygame.Surface | None = None
-        self._bg_world: Any = None
+        self._bg_world: World | None = None
         self.window: pygame.Surface | None = None
         self.clock: pygame.time.Clock | None = None
         if mode == "human":
@@ -34,7 +51,7 @@ class Renderer:
             self.window = pygame.display.set_mode((SIZE, SIZE))
             self.clock = pygame.time.Clock()
 
-    def _background(self, world: Any) -> pygame.Surface:
+    def _background(self, world: World) -> pygame.Surface:
         if self._bg is None or self._bg_world is not world:
             x0, y0, x1, y1 = world.frame
             res = max(x1 - x0, y1 - y0) / SIZE
@@ -51,13 +68,16 @@ class Renderer:
     def _px(self, x: float, y: float) -> tuple[int, int]:
         return int(round((x - self._x0) * self._scale)), int(round((self._y1 - y) * self._scale))
 
-    def draw(self, env: Any) -> np.ndarray | None:
-        """Render the env's current state; return an ``(H, W, 3)`` array in ``rgb_array`` mode."""
+    def draw(self, env: Scene, record: MissionRecord) -> np.ndarray | None:
+        """Render the env's current state with its last ``record`` (the cones' measured ranges); return an
+        ``(H, W, 3)`` array in ``rgb_array`` mode."""
+        if env.world is None or env.sim is None:
+            raise RuntimeError("render: call reset() first")
         canvas = self._background(env.world).copy()
         if len(env.path) > 1:
             pygame.draw.lines(canvas, (40, 120, 220), False, [self._px(*p) for p in env.path], 2)
         x, y, th = env.sim.pose
-        rec, suite = env._last, env.suite
+        rec, suite = record, env.suite
         for k in range(suite.n):
             lo, hi = rec.range[k]
             r = suite.r_max[k] if rec.no_echo[k] else 0.5 * (lo + hi)
@@ -99,4 +119,31 @@ class Renderer:
             self.window = None
 
 
-__all__ = ["Renderer", "FREE", "MIXED"]
+class Window:
+    """A ``size x size`` pygame window showing ``(H, W, 3)`` uint8 pictures at ``fps`` frames a second at
+    most: the ``human`` render mode of an env that draws pictures (headless with ``SDL_VIDEODRIVER=dummy``).
+    """
+
+    def __init__(self, size: int, fps: int) -> None:
+        pygame.display.init()  # display only: no audio
+        self.surface: pygame.Surface | None = pygame.display.set_mode((size, size))
+        self.clock, self.fps = pygame.time.Clock(), fps
+
+    def show(self, picture: np.ndarray) -> None:
+        """Draw ``picture`` (row 0 at the top) from the window's corner and wait for the next frame."""
+        if self.surface is None:
+            raise RuntimeError("show: the window is closed")
+        pygame.event.pump()
+        frame = pygame.surfarray.make_surface(np.ascontiguousarray(picture.transpose(1, 0, 2)))
+        self.surface.blit(frame, (0, 0))
+        pygame.display.flip()
+        self.clock.tick(self.fps)
+
+    def close(self) -> None:
+        """Close the window (again: nothing)."""
+        if self.surface is not None:
+            pygame.display.quit()
+            self.surface = None
+
+
+__all__ = ["Renderer", "Scene", "Window"]

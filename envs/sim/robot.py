@@ -14,11 +14,10 @@ the drive's force limit, so the body has inertia and lags the command) and a ``G
 ``max_force = max_torque``). Each substep the control body's velocity is set from the command ``(v, omega)``
 in the body frame: ``v`` along the body's current heading, ``omega`` its angular velocity. Walls are static
 ``pymunk.Segment`` shapes with friction (:data:`WALL_FRICTION`) and no elasticity, so the robot skids along
-them and friction turns it; contacts are pymunk's. (An earlier version drove the robot so with a unicycle
-record: the body's velocity lagged its heading, by up to 0.5 rad on reversals, and slid along walls, motions
-no unicycle with the recorded heading explains. The record's lateral velocity and the rigorous hulls below
-close that gap.) The collision circle has radius ``radius + skin``. A step of ``dt`` seconds runs ``substeps``
-pymunk steps whose durations are exact floats summing exactly to ``dt`` (:func:`.dynamics_jit.substep_times`);
+them and friction turns it; contacts are pymunk's. The body's velocity may lag its heading and slide along
+walls: the record's lateral velocity and the rigorous hulls below bound that motion. The collision circle
+has radius ``radius + skin``. A step of ``dt`` seconds runs ``substeps`` pymunk steps whose durations are
+exact floats summing exactly to ``dt`` (:func:`.dynamics_jit.substep_times`);
 while the space has no queued work they call chipmunk's step and body accessors directly (``Space.step``'s
 C call without its Python bookkeeping: the same states, bit for bit).
 The truth is the piecewise-linear path through the states read back after each substep (:mod:`.dynamics_jit`:

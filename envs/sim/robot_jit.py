@@ -2,14 +2,14 @@
 
 :func:`robot_step_kernel` runs one step of :meth:`.robot.RobotSim.step` in machine code: the substeps before
 the first blocked one run at the commanded speed, the rest of the step as one arc at the largest fraction of
-it whose sweep is clear (or 0). Both pieces are arcs of :mod:`.arc`: the heading stored is the true heading,
-and the position error each step adds is bounded there. A sweep is checked at the midpoints of ``m`` equal
-pieces of each substep's arc: the disc there must keep ``radius`` plus half a piece's travel off every edge
-(every point of the arc lies within that of a midpoint), so the nominal disc never overlaps an obstacle and
-never tunnels. The edges checked are those whose bounding box lies within ``|v| dt + radius`` of the step's
-start: every arc point of the step lies within ``|v| dt`` of it (an arc is never shorter than its chord), so
-no edge that could block is left out. If the start's clearance exceeds ``radius + |v| dt`` the whole step is
-clear without checking the arc.
+it whose sweep is clear (or 0). Both pieces are arcs of :mod:`.arc_jit`: the heading stored is the true
+heading, and the position error each step adds is bounded there. A sweep is checked at the midpoints of
+``m`` equal pieces of each substep's arc: the disc there must keep ``radius`` plus half a piece's travel off
+every edge (every point of the arc lies within that of a midpoint), so the nominal disc never overlaps an
+obstacle and never tunnels. The edges checked are those whose bounding box lies within ``|v| dt + radius``
+of the step's start: every arc point of the step lies within ``|v| dt`` of it (an arc is never shorter than
+its chord), so no edge that could block is left out. If the start's clearance exceeds ``radius + |v| dt``
+the whole step is clear without checking the arc.
 
 Example (1 m/s for 4 substeps of 0.025 s at a wall 0.25 m ahead of a disc of radius 0.2: two substeps
 run, then the disc touches the wall and stops)::
@@ -82,12 +82,12 @@ def robot_step_kernel(pose: np.ndarray, v: float, w: float, dt: float, substeps:
         radius: Disc radius.
         edges, bbox: The world's edges ``(E, 4)`` and their bounding boxes.
         fractions: Fractions of ``v`` tried, in order, once a substep is blocked.
-        pieces: Output ``(2, 3)``: the step's two pieces ``(v, tau, theta_end)`` of :mod:`.arc`, whose
+        pieces: Output ``(2, 3)``: the step's two pieces ``(v, tau, theta_end)`` of :mod:`.arc_jit`, whose
             ``tau`` sum to ``dt`` exactly (a piece may last 0 s).
 
     Returns:
         ``(first, vi, err, w_lo, w_hi)``: the substeps run at ``v``, the speed of the remaining
-        ``substeps - first``, the bound on the position error this step adds (:func:`.arc.arc_move`), and
+        ``substeps - first``, the bound on the position error this step adds (:func:`.arc_jit.arc_move`), and
         outward bounds of the true yaw rates of the pieces that last more than 0 s.
     """
     x, y, th = pose[0], pose[1], pose[2]

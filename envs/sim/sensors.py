@@ -9,7 +9,7 @@ hull. Odometry is the body-frame velocity ``(v_1, v_2)`` (forward, leftward: a D
 two components share the noise bound ``NoiseConfig.speed``) and the yaw rate; a robot that cannot slip
 (the unicycle) records ``v_2 = [0, 0]``, the known constraint, unmeasured. Ranges
 may likewise be given as rigorous bounds ``(n, 2)`` of the true distances: :meth:`SensorSuite.range_bounds`
-computes them from the simulator's pose and its proved pose error (:mod:`.arc`), so the record contains
+computes them from the simulator's pose and its proved pose error (:mod:`.arc_jit`), so the record contains
 the exact truth, floating point included, with no tolerance chosen by hand. ``tol`` is an optional extra
 widening (``tol * max(1, |bound|)``) for callers whose truths are plain floats. Ranges, noise and widening
 run compiled (:mod:`.geometry_jit`, :mod:`.noise_jit`).
@@ -18,7 +18,8 @@ run compiled (:mod:`.geometry_jit`, :mod:`.noise_jit`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -54,6 +55,15 @@ class SensorSuite:
     alpha: np.ndarray
     gamma: np.ndarray
     r_max: np.ndarray
+
+    if TYPE_CHECKING:  # set by __post_init__ (the suite is frozen); not dataclass fields at run time
+        _reach: float = field(init=False)
+        _wit: np.ndarray = field(init=False)
+        _k_alpha: np.ndarray = field(init=False)
+        _k_gamma: np.ndarray = field(init=False)
+        _k_r_max: np.ndarray = field(init=False)
+        _k_cones: np.ndarray = field(init=False)
+        _model: tuple[Any, ...] = field(init=False)
 
     def __post_init__(self) -> None:
         for name in ("alpha", "gamma", "r_max"):

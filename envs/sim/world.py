@@ -37,7 +37,10 @@ class World:
     bbox: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
-        self.frame = tuple(float(v) for v in self.frame)  # type: ignore[assignment]
+        if len(self.frame) != 4:
+            raise ValueError(f"frame: expected (xmin, ymin, xmax, ymax), got {self.frame}")
+        x0, y0, x1, y1 = (float(v) for v in self.frame)
+        self.frame = (x0, y0, x1, y1)
         if not (self.frame[0] < self.frame[2] and self.frame[1] < self.frame[3]):
             raise ValueError(f"frame: must satisfy xmin < xmax and ymin < ymax, got {self.frame}")
         self.rings = [np.asarray(r, dtype=np.float64) for r in self.rings]

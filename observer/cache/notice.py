@@ -75,7 +75,7 @@ def _isatty(stream: TextIO) -> bool:
 def _listener(notice: Notice) -> Any:
     from numba.core import event
 
-    class _Listener(event.Listener):  # type: ignore[misc]
+    class _Listener(event.Listener):  # type: ignore[misc]  # numba is untyped: the base class is Any
         def on_start(self, ev: Any) -> None:
             func = getattr(ev.data.get("dispatcher"), "py_func", None)
             notice.compiling(getattr(func, "__module__", "") or "")

@@ -33,6 +33,7 @@ import functools
 import json
 import os
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -79,11 +80,11 @@ def stamp() -> str:
     return f"{guard.project_digest()} numpy-{numpy.__version__}"
 
 
-class StoreLocator(caching.InTreeCacheLocator):  # type: ignore[misc]
+class StoreLocator(caching.InTreeCacheLocator):  # type: ignore[misc]  # numba is untyped: the base class is Any
     """numba's cache locator for digslam's kernels: the store folder (:func:`folder`), stamped with
     :func:`stamp` instead of the defining file's own hash."""
 
-    def __init__(self, py_func: Any, py_file: str) -> None:
+    def __init__(self, py_func: Callable[..., Any], py_file: str) -> None:
         super().__init__(py_func, py_file)
         self._cache_path = str(folder(py_file))
 
@@ -91,7 +92,7 @@ class StoreLocator(caching.InTreeCacheLocator):  # type: ignore[misc]
         return stamp()
 
     @classmethod
-    def from_function(cls, py_func: Any, py_file: str) -> StoreLocator | None:
+    def from_function(cls, py_func: Callable[..., Any], py_file: str) -> StoreLocator | None:
         if folder(py_file) is None:
             return None
         return super().from_function(py_func, py_file)  # None where the folder cannot be written

@@ -13,7 +13,8 @@ every coordinate. Widths and volumes are rounded up (they bound the true measure
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -158,7 +159,10 @@ def box_difference(
 CHUNK = 1 << 15
 
 
-def chunked(fn: Any, lo: np.ndarray, hi: np.ndarray) -> Any:
+_R = TypeVar("_R")
+
+
+def chunked(fn: Callable[[np.ndarray, np.ndarray], _R], lo: np.ndarray, hi: np.ndarray) -> _R:
     """``fn(lo, hi)`` applied block by block of :data:`CHUNK` rows, results concatenated.
 
     ``fn`` returns an array or nested tuples of arrays whose first axis is the row. Large batches go

@@ -8,7 +8,11 @@ dataclass declared with :func:`config_dataclass` and deriving from :class:`Confi
 * :meth:`Config.replace` copies with some fields changed, :meth:`Config.to_dict` gives plain data that
   :meth:`Config.from_dict` reads back;
 * ``__post_init__`` checks the values with the checkers below, each naming the offending field
-  (``"<field>: <what is wrong>"``).
+  (``"<field>: <what is wrong>"``);
+* :meth:`Config.from_file` reads a ``.toml`` or ``.json`` file (:func:`read_config_file`, the one reader of
+  configuration files) and :meth:`Config.override` applies ``key=value`` strings from a command line
+  (:func:`apply_overrides`, values parsed as TOML literals by :func:`parse_value`); every error is one line
+  naming the file or the key.
 
 >>> @config_dataclass
 ... class Demo(Config):
@@ -25,17 +29,31 @@ ValueError: Demo: unknown key(s) ['m']; known: ['n']
 Traceback (most recent call last):
 ...
 ValueError: n: must be an integer >= 1, got 0
+>>> Demo().override(["n=4"]).n, parse_value("{map_size = 40}"), parse_value("plain words")
+(4, {'map_size': 40}, 'plain words')
 """
 
 from __future__ import annotations
 
 import dataclasses
 import functools
+import importlib
+import json
 import math
-from collections.abc import Callable, Iterable, Mapping
-from typing import Any, TypeVar
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from pathlib import Path
+from types import ModuleType
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
+
+if TYPE_CHECKING:  # type checkers only (typing has it from Python 3.11): never imported at run time
+    from typing_extensions import dataclass_transform
+else:
+
+    def dataclass_transform(**_: object) -> Callable[[Any], Any]:
+        return lambda f: f
+
 
 C = TypeVar("C", bound="Config")
 
@@ -51,10 +69,12 @@ def reject_unknown(cls: type, keys: Iterable[str]) -> None:
         raise ValueError(f"{cls.__name__}: unknown key(s) {unknown}; known: {sorted(known)}")
 
 
+@dataclass_transform(frozen_default=True)
 def config_dataclass(cls: type[C]) -> type[C]:
     """``@dataclass(frozen=True)`` whose constructor raises ``ValueError`` (not ``TypeError``) on unknown
     keyword arguments, naming them (see :func:`reject_unknown`)."""
     cls = dataclasses.dataclass(frozen=True)(cls)
+    # mypy forbids reading __init__ off a class; the dataclass's generated one is what is wrapped here
     init: Callable[..., None] = cls.__init__  # type: ignore[misc]
 
     @functools.wraps(init)
@@ -62,6 +82,7 @@ def config_dataclass(cls: type[C]) -> type[C]:
         reject_unknown(type(self), kwargs)
         init(self, *args, **kwargs)
 
+    # the checked constructor replaces the generated one (mypy forbids assigning a method)
     cls.__init__ = __init__  # type: ignore[method-assign]
     return cls
 
@@ -82,11 +103,101 @@ class Config:
     def replace(self: C, **kwargs: Any) -> C:
         """Copy with some fields changed (unknown keys raise ``ValueError``; the copy is checked anew)."""
         reject_unknown(type(self), kwargs)
+        # a mixin: every Config is a dataclass (config_dataclass), which mypy cannot see on the base
         return dataclasses.replace(self, **kwargs)  # type: ignore[type-var]
 
     def to_dict(self) -> dict[str, Any]:
         """The fields as plain data (nested configs become dicts); ``from_dict`` reads it back."""
+        # a mixin: every Config is a dataclass (config_dataclass), which mypy cannot see on the base
         return dataclasses.asdict(self)  # type: ignore[call-overload, no-any-return]
+
+    @classmethod
+    def from_file(cls: type[C], path: str | Path, overrides: Iterable[str] = ()) -> C:
+        """Build from the table of a ``.toml`` or ``.json`` file (:func:`read_config_file`), then apply the
+        ``key=value`` strings of ``overrides`` (:meth:`override`); ``ValueError`` in one line naming the file
+        or the key."""
+        return cls.from_dict(read_config_file(path)).override(overrides)
+
+    def override(self: C, overrides: Iterable[str]) -> C:
+        """Copy with ``key=value`` strings applied (:func:`apply_overrides`): values are TOML literals, else
+        plain strings; ``head.sub=value`` sets one entry of a field that holds a table (a dict). No
+        overrides: this config itself."""
+        overrides = list(overrides)
+        if not overrides:
+            return self
+        # a mixin: every Config is a dataclass (config_dataclass), which mypy cannot see on the base
+        fields = dataclasses.fields(self)  # type: ignore[arg-type]
+        tables = [f.name for f in fields if isinstance(getattr(self, f.name), dict)]
+        return type(self).from_dict(apply_overrides(self.to_dict(), overrides, dotted=tables))
+
+
+def toml_module() -> ModuleType:
+    """The TOML reader: the standard library's ``tomllib`` (Python 3.11+), else its backport ``tomli``."""
+    try:
+        return importlib.import_module("tomllib")
+    except ModuleNotFoundError:  # Python 3.10: the same API under the backport's name
+        return importlib.import_module("tomli")
+
+
+def read_config_file(path: str | Path) -> dict[str, Any]:
+    """The table of settings in a ``.toml`` or ``.json`` file.
+
+    Raises:
+        ValueError: no such file, another suffix, unreadable text or a file that holds no table, in one
+            line that starts with ``path:`` and names the file.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise ValueError(f"path: no configuration file {str(p)!r}")
+    if p.suffix not in (".json", ".toml"):
+        raise ValueError(f"path: configuration must be .toml or .json, got {str(p)!r}")
+    try:
+        text = p.read_text()
+        data = json.loads(text) if p.suffix == ".json" else toml_module().loads(text)
+    except (OSError, UnicodeDecodeError, ValueError) as exc:  # TOMLDecodeError, JSONDecodeError
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ValueError(f"path: cannot read {str(p)!r} as {p.suffix[1:].upper()} ({first})") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"path: {str(p)!r} must hold a table of settings, got {type(data).__name__}")
+    return data
+
+
+def parse_value(raw: str) -> Any:
+    """A TOML literal (``3``, ``1e-4``, ``true``, ``"x"``, ``{map_size = 40}``), or the raw string."""
+    toml = toml_module()
+    try:
+        return toml.loads(f"v = {raw}")["v"]
+    except toml.TOMLDecodeError:
+        return raw
+
+
+def apply_overrides(data: Mapping[str, Any], overrides: Iterable[str],
+                    dotted: Sequence[str] = ()) -> dict[str, Any]:  # fmt: skip
+    """``data`` with ``key=value`` strings applied (values parsed by :func:`parse_value`); ``head.sub=value``
+    sets one entry of a table field named in ``dotted``.
+
+    Raises:
+        ValueError: a string without ``=``, a key not in ``data``, or a dotted key on a field not in
+            ``dotted``, naming the key.
+    """
+    out = dict(data)
+    for item in overrides:
+        key, sep, raw = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise ValueError(f"overrides: expected key=value, got {item!r}")
+        value = parse_value(raw.strip())
+        head, _, sub = key.partition(".")
+        if head not in out:
+            raise ValueError(f"{head}: unknown key; known: {sorted(out)}")
+        if sub:
+            if head not in dotted:
+                raise ValueError(f"{key}: only {' and '.join(dotted)} takes dotted keys" if dotted
+                                 else f"{key}: no key takes dotted keys")  # fmt: skip
+            out[head] = {**out[head], sub: value}
+        else:
+            out[head] = value
+    return out
 
 
 def check(cond: bool, name: str, msg: str) -> None:
@@ -137,6 +248,7 @@ def check_choice(name: str, v: Any, choices: Iterable[Any]) -> None:
 
 __all__ = [
     "Config",
+    "apply_overrides",
     "check",
     "check_choice",
     "check_finite_nonneg",
@@ -146,5 +258,8 @@ __all__ = [
     "config_dataclass",
     "is_int",
     "is_number",
+    "parse_value",
+    "read_config_file",
     "reject_unknown",
+    "toml_module",
 ]

@@ -25,7 +25,7 @@ def _count(a: np.ndarray, v: float, strict: bool) -> int:
 
     ``np.searchsorted`` with ``side="left"`` counts the entries ``< v`` and ``side="right"`` those
     ``<= v`` (equal values included or not, exactly); a NaN ``v`` counts 0 (numpy would place it after
-    every number), as the bisection this replaced did, so a NaN bound never widens a window.
+    every number), so a NaN bound never widens a window.
     """
     if v != v:
         return 0

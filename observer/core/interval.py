@@ -180,17 +180,19 @@ class IntervalArray:
         lo, hi = as_pair(other)
         return np.maximum(self.lo, lo) <= np.minimum(self.hi, hi)
 
+    # elementwise, as numpy's: a bool array, where object.__eq__ returns a bool
     def __eq__(self, other: object) -> Any:  # type: ignore[override]
         if not isinstance(other, (IntervalArray, int, float, np.ndarray)):
             return NotImplemented
         lo, hi = as_pair(other)
         return (self.lo == lo) & (self.hi == hi)
 
+    # elementwise, as __eq__
     def __ne__(self, other: object) -> Any:  # type: ignore[override]
         eq = self.__eq__(other)
         return eq if eq is NotImplemented else ~eq
 
-    __hash__ = None  # type: ignore[assignment]
+    __hash__ = None  # type: ignore[assignment]  # mutable arrays compared elementwise: unhashable
 
     def __bool__(self) -> bool:
         raise TypeError("IntervalArray: truth value is ambiguous; use is_empty(), contains() or issubset()")
@@ -271,9 +273,10 @@ def Box(bounds: Sequence[Sequence[float]] | IntervalArray) -> IntervalArray:  # 
     return IntervalArray(b[:, 0], b[:, 1])
 
 
+# Interval is a factory function: the constructors of IntervalArray ride on it as attributes
 Interval.empty = IntervalArray.empty  # type: ignore[attr-defined]
-Interval.entire = IntervalArray.entire  # type: ignore[attr-defined]
-Interval.pi = lambda: IntervalArray._raw(  # type: ignore[attr-defined]
+Interval.entire = IntervalArray.entire  # type: ignore[attr-defined]  # as Interval.empty
+Interval.pi = lambda: IntervalArray._raw(  # type: ignore[attr-defined]  # as Interval.empty
     np.asarray(3.141592653589793), np.asarray(np.nextafter(3.141592653589793, np.inf))
 )
 

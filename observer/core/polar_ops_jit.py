@@ -91,7 +91,8 @@ def _atan2(yl: float, yh: float, xl: float, xh: float) -> tuple[float, float]:
 
 @njit
 def point_angle(xl: float, xh: float, yl: float, yh: float) -> tuple[float, float]:
-    """One representative of ``arg`` over the box, continuous across the cut (``polar_ctc.point_angle``)."""
+    """One representative of ``arg`` over the box, continuous across the cut (as the numpy oracle
+    ``tests/polar_oracle.py`` computes it)."""
     if xh < 0:  # π + atan2(-y, -x): smooth around θ = π
         a, b = _atan2(-yh, -yl, -xh, -xl)
         return add_dn(a, PI_DOWN), add_up(b, PI_UP)
@@ -107,7 +108,8 @@ def _widen(v: float, mag: float, upward: bool) -> float:
 
 @njit
 def lift(al: float, ah: float, tl: float, th: float) -> tuple[float, float]:
-    """Smallest and largest representative of ``[a] + 2kπ`` in ``[θ]`` (``polar_ctc._lift``)."""
+    """Smallest and largest representative of ``[a] + 2kπ`` in ``[θ]`` (as the numpy oracle
+    ``tests/polar_oracle.py`` lifts it)."""
     low, high = _INF, -_INF
     for is_low in (True, False):
         base = math.ceil((tl - ah) / TWO_PI_DOWN) if is_low else math.floor((th - al) / TWO_PI_DOWN)
@@ -151,7 +153,7 @@ def cross(c0: float, c1: float, s0: float, s1: float, xl: float, xh: float, yl: 
 @njit
 def pmul(a0: float, a1: float, b0: float, b1: float) -> tuple[float, float]:
     """``[a]·[b]`` for finite bounds: the round-to-nearest products' extremes stepped out by one ulp
-    (each product is within half an ulp, :func:`~.jit.dn` is monotone); exact when ``[b] = 0``."""
+    (each product is within half an ulp, :func:`~.scalar_jit.dn` is monotone); exact when ``[b] = 0``."""
     if b0 == 0.0 and b1 == 0.0:
         return 0.0, 0.0
     p, q, u, v = a0 * b0, a0 * b1, a1 * b0, a1 * b1

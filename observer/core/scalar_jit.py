@@ -13,8 +13,9 @@ boxes in machine code instead; this module gives them the same guarantee as :mod
   (:func:`wdn`, :func:`wup`).
 
 Every scalar interval primitive of the project's kernels lives here: :func:`meet`, :func:`iadd`,
-:func:`isub`, :func:`imul`, :func:`idiv` (the hull), :func:`ixdiv` (set-based), :func:`isqr`, :func:`isqrt`,
-:func:`iexp`, :func:`ilog`, :func:`ipown`, :func:`iabs`. The empty interval is ``[+inf, -inf]``, as in
+:func:`isub`, :func:`imul` (and its one-step bounds for finite intervals, :func:`imul_lo`, :func:`imul_hi`),
+:func:`idiv` (the hull), :func:`ixdiv` (set-based), :func:`isqr`, :func:`isqrt`, :func:`iexp`, :func:`ilog`,
+:func:`ipown`, :func:`iabs`. The empty interval is ``[+inf, -inf]``, as in
 :mod:`.arith`; an operand with an infinite point (``[+inf, +inf]``, ``[-inf, -inf]``) holds no real and gives
 the empty interval too (:func:`nil`). Every kernel here is checked against exact rational arithmetic in
 ``tests/observer/core/test_scalar_jit.py``.
@@ -42,7 +43,8 @@ from digslam.observer.core.rounding import LIBM_ULPS
 
 __all__ = ["LIBM_ULPS", "njit", "dn", "up", "wdn", "wup", "add_dn", "add_up", "sub_dn", "sub_up",
            "mul_dn", "mul_up", "div_dn", "div_up", "sqrt_dn", "sqrt_up", "nil", "meet", "iadd", "isub",
-           "imul", "isqr", "idiv", "ixdiv", "isqrt", "iexp", "ilog", "ipown", "iabs"]  # fmt: skip
+           "imul", "imul_lo", "imul_hi", "isqr", "idiv", "ixdiv", "isqrt", "iexp", "ilog", "ipown",
+           "iabs"]  # fmt: skip
 
 _INF = math.inf
 
@@ -187,6 +189,23 @@ def imul(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
     lo = min(min(mul_dn(al, bl), mul_dn(al, bh)), min(mul_dn(ah, bl), mul_dn(ah, bh)))
     hi = max(max(mul_up(al, bl), mul_up(al, bh)), max(mul_up(ah, bl), mul_up(ah, bh)))
     return lo, hi
+
+
+@njit(forceinline=True)
+def imul_lo(al: float, ah: float, bl: float, bh: float) -> float:
+    """Lower bound of ``[a]·[b]`` for finite bounds, in one rounding step: the smallest of the four
+    round-to-nearest corner products, one :func:`dn` step down. Each product is within half an ulp of its
+    exact value and :func:`dn` is monotone, so that step bounds them all. One step instead of
+    :func:`imul`'s four, and one ulp looser where the smallest product is an exact 0 (``-2⁻¹⁰⁷⁴``, where
+    :func:`imul` keeps 0); a non-finite bound may give NaN."""
+    return dn(min(al * bl, al * bh, ah * bl, ah * bh))
+
+
+@njit(forceinline=True)
+def imul_hi(al: float, ah: float, bl: float, bh: float) -> float:
+    """Upper bound of ``[a]·[b]`` for finite bounds: the largest corner product, one :func:`up` step up
+    (:func:`imul_lo`'s argument)."""
+    return up(max(al * bl, al * bh, ah * bl, ah * bh))
 
 
 @njit(forceinline=True)

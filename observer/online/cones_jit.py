@@ -187,8 +187,8 @@ def contract_cones(free: np.ndarray, grid: tuple, x0: float, y0: float, x1: floa
     """The position box ``[x0, x1] × [y0, y1]`` with slices shaved off its four sides while a slice holds no
     position that meets all but at most ``q`` cone constraints (:func:`box_feasible`); the slices start at
     a quarter of the side and halve down to :data:`MIN_SLICE`; ``(inf, inf, -inf, -inf)`` when the whole
-    box fails. ``grid`` is a :class:`.dig_jit.GridFrame` (or the tuple of its fields), ``alpha``,
-    ``gamma``, ``ranges``, ``no_echo`` the step's cones (:class:`.dig_jit.StepRecord`), ``[psi_lo,
+    box fails. ``grid`` is a :class:`.dig_types.GridFrame` (or the tuple of its fields), ``alpha``,
+    ``gamma``, ``ranges``, ``no_echo`` the step's cones (:class:`.dig_types.StepRecord`), ``[psi_lo,
     psi_hi]`` the heading interval."""
     xs, ys, nys = grid[0], grid[1], grid[2]
     if not box_feasible(free, xs, ys, nys, x0, y0, x1, y1, psi_lo, psi_hi, alpha, gamma, ranges, no_echo, q):

@@ -1,7 +1,8 @@
 """Compiled cell kernels of the online Dig-SLAM filter: digging ``M⁻`` (thesis §6.4, Eq. 6.21).
 
-One step of :class:`~.online.OnlineDigSlam` touches the cells within sensor reach of the pose box ``[x]``.
-These kernels loop over those cells in machine code, each bound outward rounded with :mod:`.jit`.
+One step of :class:`~digslam.observer.online.observer.OnlineDigSlam` touches the cells within sensor reach of
+the pose box ``[x]``. These kernels loop over those cells in machine code, each bound outward rounded with
+:mod:`digslam.observer.core.scalar_jit`.
 :func:`dig_cells` digs ``M⁻ := M⁻ ∪ g⁻¹_{[x]}(Z⁻)`` for one reading: a cell is dug when its relative box
 ``c - [x]`` (outward rounded) lies strictly inside the open disk ``ρ < r`` (farthest corner, squared
 distance rounded up) and, for a cone, inside the narrowed cone ``θ ∈ [θ₁, θ₂]`` with ``θ₁ = ψ⁺ + α - γ``,
@@ -19,12 +20,9 @@ readings of the step that prove it free, and :func:`.mark_jit.dig_and_mark_q` di
 Skipping a cell never makes a false claim here (it is just not dug), so the windows are float estimates
 padded by two cells; every claim is proved cell by cell.
 
-The kernels take their inputs as named tuples (the kernel rules of :mod:`digslam.observer.core`):
-:class:`GridFrame` (the grid, built once per grid by :func:`.window.grid_frame`), :class:`CellSets` (the
-filter's cell sets), :class:`PoseBox` (one pose box and heading interval), :class:`CellAxes` (the per-row
-and per-column bounds shared by the readings of one pose box), :class:`SectorBatch` (a batch of readings,
-one pose box each) and :class:`StepRecord` (one step's record, read by the pose and marking kernels too):
-the online folder's kernels share these types.
+The kernels take their inputs as the named tuples of :mod:`.dig_types` (:class:`~.dig_types.GridFrame`,
+:class:`~.dig_types.CellSets`, :class:`~.dig_types.PoseBox`, :class:`~.dig_types.CellAxes`,
+:class:`~.dig_types.SectorBatch`).
 
 >>> from digslam.observer.online.window import grid_frame
 >>> from digslam.observer.record.grid import Grid
@@ -38,7 +36,6 @@ the online folder's kernels share these types.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 
@@ -48,25 +45,19 @@ from digslam.observer.core.rounding import PI_DOWN
 from digslam.observer.core.scalar_jit import (
     add_dn,
     add_up,
-    dn,
+    imul_hi,
+    imul_lo,
     mul_dn,
     mul_up,
     njit,
     sub_dn,
     sub_up,
-    up,
     wdn,
     wup,
 )
+from digslam.observer.online.dig_types import CellAxes, CellSets, GridFrame, PoseBox, SectorBatch
 
 __all__ = [
-    "CellAxes",
-    "CellSets",
-    "NO_MEAN",
-    "GridFrame",
-    "PoseBox",
-    "SectorBatch",
-    "StepRecord",
     "box_ok",
     "cell_size",
     "cone_window",
@@ -75,143 +66,9 @@ __all__ = [
     "dig_reading",
     "edge_direction",
     "in_frame",
-    "prod_hi",
-    "prod_lo",
     "reach_axes",
     "union",
 ]
-
-
-class GridFrame(NamedTuple):
-    """The online filter's grid as its kernels read it (:func:`.window.grid_frame` builds it once per grid).
-
-    The frame is ``[xs[0], xs[-1]] × [ys[-1], ys[0]]`` and the cell size :func:`cell_size`, both exactly
-    those of the :class:`~digslam.observer.record.grid.Grid` (whose bounds are a ``linspace`` of its frame):
-    they are not stored, so that the tuple stays small (each field costs at every call from Python).
-
-    Attributes:
-        xs: ``(nx + 1,)`` exact column bounds, increasing.
-        ys: ``(ny + 1,)`` exact row bounds, decreasing (row 0 at the top).
-        nys: ``-ys`` (increasing), for :func:`~digslam.observer.core.grid_jit.window`.
-        keep, off: the constants of the clearance lower bound ``D·keep - off`` (``keep = 1 - EDT_SLACK``,
-            ``off = diag + EDT_SLACK·span``, as in :meth:`.digmap.DigMap.clearance_lower`).
-    """
-
-    xs: np.ndarray
-    ys: np.ndarray
-    nys: np.ndarray
-    keep: float
-    off: float
-
-
-class CellSets(NamedTuple):
-    """The online filter's cell sets, updated in place by the kernels (all C-contiguous).
-
-    Attributes:
-        free: ``(ny, nx)`` bool, ``M⁻``: the cells proved free (dug, Eq. 6.21).
-        sure: ``(ny, nx)`` bool, the certainly sensed cells ``Z⁻`` (the dug cells).
-        maybe: ``(ny, nx)`` bool, the possibly sensed cells ``Z⁺`` (Eq. B.5).
-        count: ``(2, ny, nx)`` int32, zero between steps: per cell, the readings of the step that prove it
-            free and the last reading that counted it (the q-relaxed mode; ``(2, 1, 1)`` when unused).
-        listed: ``(ny·nx + 1,)`` int32, ``listed[0] = 0`` between steps: the number of cells counted in the
-            step, then their flat indices ``i·nx + j`` (q-relaxed mode; ``(1,)`` when unused).
-    """
-
-    free: np.ndarray
-    sure: np.ndarray
-    maybe: np.ndarray
-    count: np.ndarray  # type: ignore[assignment]  # a field, shadowing tuple.count
-    listed: np.ndarray
-
-
-class PoseBox(NamedTuple):
-    """One pose box: the position box ``[x]`` and the heading interval ``[ψ]`` (scalars).
-
-    Attributes:
-        x_lo, y_lo, x_hi, y_hi: the position box ``[x⁻, x⁺] × [y⁻, y⁺]``.
-        psi_lo, psi_hi: the heading interval ``[ψ⁻, ψ⁺]``.
-    """
-
-    x_lo: float
-    y_lo: float
-    x_hi: float
-    y_hi: float
-    psi_lo: float
-    psi_hi: float
-
-
-class CellAxes(NamedTuple):
-    """Bounds of the relative boxes ``c - [x]`` of the cells of a window, per column and per row
-    (:func:`reach_axes`): shared by every reading of one pose box, each cell test then only compares them.
-
-    Attributes:
-        cols: ``(4, nc)``: per column from ``col0``, the lower and upper bound of ``x_c - [x]`` (outward
-            rounded), the farthest squared distance (rounded up) and the nearest (rounded down).
-        rows: ``(4, nr)``: the same per row from ``row0``, for ``y``.
-        row0, col0: the window's first row and column.
-    """
-
-    cols: np.ndarray
-    rows: np.ndarray
-    row0: int
-    col0: int
-
-
-class SectorBatch(NamedTuple):
-    """A batch of readings, each from its own pose box (:func:`dig_batch`).
-
-    Attributes:
-        lo, hi: ``(N, 2)`` the pose boxes.
-        psi_lo, psi_hi: ``(N,)`` the heading intervals.
-        alpha, gamma: ``(N,)`` the cone directions (relative to the heading) and half-apertures.
-        r: ``(N,)`` the free ranges.
-        disk: ``(N,)`` bool: the omnidirectional sensor (the open disk; ``psi``, ``alpha``, ``gamma`` unused).
-    """
-
-    lo: np.ndarray
-    hi: np.ndarray
-    psi_lo: np.ndarray
-    psi_hi: np.ndarray
-    alpha: np.ndarray
-    gamma: np.ndarray
-    r: np.ndarray
-    disk: np.ndarray
-
-
-#: The mean velocity of a record that does not measure it (``MissionRecord``'s default): never written.
-NO_MEAN = np.array([[-math.inf, math.inf], [-math.inf, math.inf]])
-NO_MEAN.flags.writeable = False
-
-
-class StepRecord(NamedTuple):
-    """One single-step record as the filter's kernels read it: the fields of a single-step
-    :class:`~digslam.observer.record.mission.MissionRecord` and the duration of the step that ends at it.
-
-    Attributes:
-        dt: ``t_k - t_{k-1}``, the duration of the step (0 for the first record of an episode).
-        speed, lateral: ``(2,)`` the body-frame velocity ``v = (v_1, v_2)`` (forward, leftward), bounding the
-            truth over the step (``x' = R(ψ) v``, Eq. 3.59, 6.12, B.20; ``lateral = [0, 0]``: a unicycle).
-        yaw_rate: ``(2,)`` the yaw-rate interval, bounding the truth over the step.
-        heading: ``(2,)`` the compass interval at ``t_k``.
-        alpha, gamma, r_max: ``(n,)`` the cones' directions (relative to the heading), half-apertures and
-            maximum ranges.
-        ranges: ``(n, 2)`` the range intervals (``[r_max, inf]`` where ``no_echo``).
-        no_echo: ``(n,)`` bool, True where nothing lies in the cone up to ``r_max``.
-        mean_velocity: ``(2, 2)`` the body-frame velocity averaged over the step (rows ``v̄_1``, ``v̄_2``;
-            ``[-inf, inf]`` twice when not measured, the default).
-    """
-
-    dt: float
-    speed: np.ndarray
-    lateral: np.ndarray
-    yaw_rate: np.ndarray
-    heading: np.ndarray
-    alpha: np.ndarray
-    gamma: np.ndarray
-    r_max: np.ndarray
-    ranges: np.ndarray
-    no_echo: np.ndarray
-    mean_velocity: np.ndarray = NO_MEAN
 
 
 @njit(forceinline=True)
@@ -227,20 +84,6 @@ def in_frame(grid: GridFrame, x0: float, y0: float, x1: float, y1: float) -> boo
     """Whether the box ``[x0, x1] × [y0, y1]`` is non-empty and lies in the frame of ``grid``."""
     xs, ys = grid.xs, grid.ys
     return xs[0] <= x0 <= x1 <= xs[xs.size - 1] and ys[ys.size - 1] <= y0 <= y1 <= ys[0]
-
-
-@njit(forceinline=True)
-def prod_lo(al: float, ah: float, bl: float, bh: float) -> float:
-    """Lower bound of ``[a]·[b]`` (finite bounds): each product is within half an ulp, so one
-    :func:`~digslam.observer.core.scalar_jit.dn` step of the smallest bounds them all."""
-    return dn(min(al * bl, al * bh, ah * bl, ah * bh))
-
-
-@njit(forceinline=True)
-def prod_hi(al: float, ah: float, bl: float, bh: float) -> float:
-    """Upper bound of ``[a]·[b]`` (finite bounds): one :func:`~digslam.observer.core.scalar_jit.up` step of
-    the largest product."""
-    return up(max(al * bl, al * bh, ah * bl, ah * bh))
 
 
 @njit
@@ -278,7 +121,8 @@ def cone_window(grid: GridFrame, box: PoseBox, t1: float, t2: float, r: float, p
 
 @njit
 def _axes(grid: GridFrame, box: PoseBox, r0: int, r1: int, c0: int, c1: int) -> tuple[np.ndarray, np.ndarray]:
-    """:attr:`CellAxes.cols` of the columns ``c0:c1`` and :attr:`CellAxes.rows` of the rows ``r0:r1``."""
+    """:attr:`~.dig_types.CellAxes.cols` of the columns ``c0:c1`` and :attr:`~.dig_types.CellAxes.rows` of the
+    rows ``r0:r1``."""
     xs, ys = grid.xs, grid.ys
     ax, ay = np.empty((4, c1 - c0)), np.empty((4, r1 - r0))
     for j in range(c0, c1):
@@ -305,7 +149,7 @@ def _dig_cone(cells: CellSets, grid: GridFrame, box: PoseBox, t1: float, t2: flo
     reading ``sid - 1``) only counts: each proved cell not yet in ``M⁻`` gets ``count[0] += 1`` once per
     reading (``count[1]`` holds the reading that counted it last, so the two halves of a wide cone count
     once), a cell counted for the first time in the step is appended to ``listed``, and the window returned
-    is that of the counted cells (:class:`CellSets`).
+    is that of the counted cells (:class:`~.dig_types.CellSets`).
 
     The bounds that depend on the column only (``p_x`` terms) or on the row only (``p_y`` terms) are
     computed once; each cell then compares them. A comparison ``a ≥ b`` of two bounds is exact, and so is
@@ -334,7 +178,7 @@ def _dig_cone(cells: CellSets, grid: GridFrame, box: PoseBox, t1: float, t2: flo
     xl, xh, fx2 = ax[0, c0 - C0 : c1 - C0], ax[1, c0 - C0 : c1 - C0], ax[2, c0 - C0 : c1 - C0]
     if not disk:
         for k in range(n):
-            sx1[k], sx2[k] = prod_hi(s1l, s1h, xl[k], xh[k]), prod_lo(s2l, s2h, xl[k], xh[k])
+            sx1[k], sx2[k] = imul_hi(s1l, s1h, xl[k], xh[k]), imul_lo(s2l, s2h, xl[k], xh[k])
     for i in range(r0, r1):
         fy2 = ay[2, i - R0]
         if not fy2 < r2:
@@ -342,7 +186,7 @@ def _dig_cone(cells: CellSets, grid: GridFrame, box: PoseBox, t1: float, t2: flo
         cy1 = cy2 = 0.0
         if not disk:
             dyl, dyh = ay[0, i - R0], ay[1, i - R0]
-            cy1, cy2 = prod_lo(c1l, c1h, dyl, dyh), prod_hi(c2l, c2h, dyl, dyh)
+            cy1, cy2 = imul_lo(c1l, c1h, dyl, dyh), imul_hi(c2l, c2h, dyl, dyh)
         fr, sr = free[i, c0:c1], sure[i, c0:c1]  # row slices indexed from 0 (no wraparound checks)
         if sid:
             cc, cs = cnt[0, i, c0:c1], cnt[1, i, c0:c1]
@@ -409,8 +253,8 @@ def union(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> tuple[i
 
 @njit
 def reach_axes(grid: GridFrame, box: PoseBox, r: float) -> CellAxes:
-    """:class:`CellAxes` of the window of the position box grown by ``r`` plus two cells, which holds the
-    window of every reading of range ``<= r`` from ``box``."""
+    """:class:`~.dig_types.CellAxes` of the window of the position box grown by ``r`` plus two cells, which
+    holds the window of every reading of range ``<= r`` from ``box``."""
     xs, ys = grid.xs, grid.ys
     pad = 2.0 * max(xs[1] - xs[0], ys[0] - ys[1])
     r0, r1, c0, c1 = window(xs, grid.nys, box.x_lo - r - pad, box.y_lo - r - pad, box.x_hi + r + pad,

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from digslam.observer.online.dig_jit import CellSets, GridFrame
+from digslam.observer.online.dig_types import CellSets, GridFrame
 from digslam.observer.online.smooth_jit import RecordArrays, mark_record, sweep
 
 __all__ = ["StepHistory"]
@@ -61,7 +61,7 @@ class StepHistory:
              d: tuple[float, float, float, float] | None, cells: CellSets, grid: GridFrame
              ) -> None:  # fmt: skip
         """Store one step (``d`` None for the first): its record (the fields of a
-        :class:`.dig_jit.StepRecord`, ``t`` in place of ``dt``), box, heading and displacement box."""
+        :class:`.dig_types.StepRecord`, ``t`` in place of ``dt``), box, heading and displacement box."""
         if self.n == self.capacity:
             self._drop_half(cells, grid)
         k = self.n

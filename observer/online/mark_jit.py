@@ -1,5 +1,5 @@
 """Compiled kernels of the online filter's possibly sensed zone ``Z⁺`` (App. B, Eq. B.5) and of one step's
-readings (§6.4, Eq. 6.21 then B.5), outward rounded with :mod:`.jit`.
+readings (§6.4, Eq. 6.21 then B.5), outward rounded with :mod:`digslam.observer.core.scalar_jit`.
 
 :func:`mark_cells` grows the outer explored zone: a cell stays unmarked only when it is *proved* to miss
 the widened sector ``x + {ρ <= r⁺, θ ∈ [ψ⁻ + α - γ, ψ⁺ + α + γ]}`` (angles rounded outwards) for every
@@ -15,7 +15,7 @@ out means marked: a doubt never makes a cell dark.
 :func:`mark_cells` for its upper range, sharing the per-row / per-column bounds of the pose box.
 :func:`dig_and_mark_q` is the same step robust to at most ``q`` outliers among the step's readings
 (§2.6.2): a cell is dug where ``q + 1`` readings prove it free, ``Z⁺`` grows with the maximum ranges.
-The readings come as a :class:`.dig_jit.StepRecord` (only its readings are read here).
+The readings come as a :class:`.dig_types.StepRecord` (only its readings are read here).
 
 >>> from digslam.observer.online.window import grid_frame
 >>> from digslam.observer.record.grid import Grid
@@ -34,22 +34,16 @@ import numpy as np
 
 from digslam.observer.core.grid_jit import window
 from digslam.observer.core.rounding import HALF_PI_DOWN, PI_DOWN
-from digslam.observer.core.scalar_jit import add_dn, add_up, mul_up, njit, sub_dn, sub_up
+from digslam.observer.core.scalar_jit import add_dn, add_up, imul_hi, imul_lo, mul_up, njit, sub_dn, sub_up
 from digslam.observer.online.dig_jit import (
-    CellAxes,
-    CellSets,
-    GridFrame,
-    PoseBox,
-    StepRecord,
     box_ok,
     cone_window,
     dig_reading,
     edge_direction,
-    prod_hi,
-    prod_lo,
     reach_axes,
     union,
 )
+from digslam.observer.online.dig_types import CellAxes, CellSets, GridFrame, PoseBox, StepRecord
 
 __all__ = ["mark_cells", "mark_batch", "dig_and_mark", "dig_and_mark_q"]
 
@@ -88,7 +82,7 @@ def _mark(maybe: np.ndarray, grid: GridFrame, box: PoseBox, alpha: float, gamma:
     xl, xh, mx2 = ax[0, c0 - C0 : c1 - C0], ax[1, c0 - C0 : c1 - C0], ax[3, c0 - C0 : c1 - C0]
     if narrow:
         for k in range(n):
-            sx1[k], sx2[k] = prod_lo(s1l, s1h, xl[k], xh[k]), prod_hi(s2l, s2h, xl[k], xh[k])
+            sx1[k], sx2[k] = imul_lo(s1l, s1h, xl[k], xh[k]), imul_hi(s2l, s2h, xl[k], xh[k])
             out_col[k] = (right and xh[k] < 0.0) or (left and xl[k] > 0.0)
     for i in range(r0, r1):
         dyl, dyh, my2 = ay[0, i - R0], ay[1, i - R0], ay[3, i - R0]
@@ -96,7 +90,7 @@ def _mark(maybe: np.ndarray, grid: GridFrame, box: PoseBox, alpha: float, gamma:
             continue
         cy1 = cy2 = 0.0
         if narrow:
-            cy1, cy2 = prod_hi(c1l, c1h, dyl, dyh), prod_lo(c2l, c2h, dyl, dyh)
+            cy1, cy2 = imul_hi(c1l, c1h, dyl, dyh), imul_lo(c2l, c2h, dyl, dyh)
         mr = maybe[i, c0:c1]  # a row slice indexed from 0 (no wraparound checks)
         for k in range(n):
             if mr[k] or mx2[k] + my2 > r2:  # nearest point beyond r⁺ (exact: monotone rounding)
@@ -133,7 +127,7 @@ def dig_and_mark(cells: CellSets, grid: GridFrame, box: PoseBox, step: StepRecor
                  ) -> tuple[int, int, int, int]:  # fmt: skip
     """One step's readings from one pose box: dig each free range ``min(y⁻, r_max)`` (``gamma >= π⁻`` is
     the omnidirectional disk); with ``mark``, grow ``Z⁺`` with ``min(y⁺, r_max)``. ``step``: a
-    :class:`.dig_jit.StepRecord` (its ``alpha``, ``gamma``, ``r_max`` and ``ranges``). The per-row and
+    :class:`.dig_types.StepRecord` (its ``alpha``, ``gamma``, ``r_max`` and ``ranges``). The per-row and
     per-column bounds (:func:`.dig_jit.reach_axes`) are computed once for all the readings; returns the
     smallest window ``(r0, r1, c0, c1)`` holding every cell changed (``(0, 0, 0, 0)`` when none).
     :func:`dig_and_mark_q` with ``q = 0``."""
@@ -170,7 +164,7 @@ def dig_and_mark_q(cells: CellSets, grid: GridFrame, box: PoseBox, step: StepRec
 
     ``q > 0`` (thesis §2.6.2, the q-relaxed intersection, Eq. 2.54, applied to the readings of ONE step):
     each reading's free-range proof only counts, in ``cells.count`` (the counted cells listed in
-    ``cells.listed``, :class:`.dig_jit.CellSets`), and a cell is dug (``M⁻`` and certainly sensed ``Z⁻``)
+    ``cells.listed``, :class:`.dig_types.CellSets`), and a cell is dug (``M⁻`` and certainly sensed ``Z⁻``)
     only where ``q + 1`` readings of the step prove it free: one of them at least is an inlier, so the cell
     is free and was sensed. With ``q >= n`` nothing is dug. An outlier's upper range can be below the truth,
     so ``Z⁺`` is grown with ``r_max`` for every reading: the union over all the choices of at most

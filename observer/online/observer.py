@@ -50,7 +50,8 @@ readings of different steps may hold ``q`` outliers each) miss the truth; the od
 
 So up to ``q`` bad readings per step make no false claim at all. With more, the guarantee is that of
 ``q = 0`` with bad data: an empty box is still reported (the filter stops and withdraws its claims), but
-claims made before that may be false. ``q = 0`` runs exactly the former kernels (bit for bit, same speed).
+claims made before that may be false. ``q = 0`` counts nothing: each reading digs at once
+(:func:`.mark_jit.dig_and_mark`).
 
 >>> from digslam.observer.record.mission import MissionRecord
 >>> def step(k):
@@ -76,7 +77,7 @@ import numpy as np
 
 from digslam.observer.core import rounding as rnd
 from digslam.observer.core.config import Config, check, check_int, config_dataclass
-from digslam.observer.online.dig_jit import NO_MEAN, CellSets, PoseBox, StepRecord
+from digslam.observer.online.dig_types import NO_MEAN, CellSets, PoseBox, StepRecord
 from digslam.observer.online.history import StepHistory
 from digslam.observer.online.mark_jit import dig_and_mark_q
 from digslam.observer.online.step_jit import filter_step_flat
@@ -142,7 +143,7 @@ def band_of(psi: np.ndarray) -> tuple[float, float]:
 
 
 def _step_record(rec: MissionRecord, dt: float) -> StepRecord:
-    """The kernels' view of a single-step record (:class:`.dig_jit.StepRecord`): its arrays, not copied
+    """The kernels' view of a single-step record (:class:`.dig_types.StepRecord`): its arrays, not copied
     (``lateral`` unset, as in a record built without ``MissionRecord.__init__``: ``[0, 0]``, a unicycle;
     ``mean_velocity`` unset: not measured)."""
     lat = rec.lateral if rec.lateral is not None else _NO_SLIP
@@ -163,7 +164,7 @@ class OnlineDigSlam:
         heading_lo, heading_hi: heading interval at the last step.
         dig: the dig zone ``M⁻`` (:class:`~.window.WindowDigMap`; ``dig.free`` bool ``(ny, nx)``).
         sensed_sure, sensed_maybe: ``(ny, nx)`` bool, certainly / possibly sensed cells.
-        cells: those sets as the kernels take them (:class:`.dig_jit.CellSets`: ``dig.free``,
+        cells: those sets as the kernels take them (:class:`.dig_types.CellSets`: ``dig.free``,
             ``sensed_sure``, ``sensed_maybe`` and the per-cell counts of the q-relaxed mode), per episode.
         consistent, inconsistent_step: False and the step index (``reset`` is step 0) once the data
             contradicted their bounds; the sets then carry no guarantee and ``update`` does nothing.
@@ -193,7 +194,7 @@ class OnlineDigSlam:
         # per-cell reading counts and stamps of the q-relaxed mode (zero between steps; unused when q = 0)
         self._cnt = np.zeros((2, *self.grid.shape) if self._q else (2, 1, 1), dtype=np.int32)
         self._lst = np.zeros(self.grid.shape[0] * self.grid.shape[1] + 1 if self._q else 1, dtype=np.int32)
-        #: The cell sets as the kernels read them (:class:`.dig_jit.CellSets`), built once per episode.
+        #: The cell sets as the kernels read them (:class:`.dig_types.CellSets`), built once per episode.
         self.cells = CellSets(self.dig.free, self.sensed_sure, self.sensed_maybe, self._cnt, self._lst)
         # the same, and the grid's frame, as plain tuples: what :func:`.step_jit.filter_step_flat` takes
         self._cells_t, self._frame_t = tuple(self.cells), tuple(self.dig.frame)

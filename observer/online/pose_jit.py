@@ -1,5 +1,6 @@
 """Compiled pose kernels of the online Dig-SLAM filter: the tube prediction (Eq. 6.23) and the impact
-contractor on the cells of one pose box (Eq. 6.22), outward rounded with :mod:`.jit`.
+contractor on the cells of one pose box (Eq. 6.22), outward rounded with
+:mod:`digslam.observer.core.scalar_jit`.
 
 * :func:`predict` is one step of the tube: ``ψ_k ∈ ([ψ_{k-1}] + [dt]·[ω_k]) ∩ [compass]``, the heading over
   the slice ``[t_{k-1}, t_k]`` (both ends reachable, the gyro bounding the drift), and
@@ -30,8 +31,9 @@ import numpy as np
 
 from digslam.observer.core.angles_jit import axes_in
 from digslam.observer.core.grid_jit import window
-from digslam.observer.core.scalar_jit import dn, iadd, imul, isub, njit, up
-from digslam.observer.online.dig_jit import GridFrame, PoseBox, StepRecord, cell_size, prod_hi, prod_lo
+from digslam.observer.core.scalar_jit import dn, iadd, imul, imul_hi, imul_lo, isub, njit, up
+from digslam.observer.online.dig_jit import cell_size
+from digslam.observer.online.dig_types import GridFrame, PoseBox, StepRecord
 
 __all__ = [
     "cos_sin",
@@ -50,9 +52,9 @@ TRIG_PAD = 2e-15
 
 @njit(forceinline=True)
 def _mul(al: float, ah: float, bl: float, bh: float) -> tuple[float, float]:
-    """Outward-rounded product of two finite intervals (:func:`.dig_jit.prod_lo`,
-    :func:`.dig_jit.prod_hi`)."""
-    return prod_lo(al, ah, bl, bh), prod_hi(al, ah, bl, bh)
+    """Outward-rounded product of two finite intervals
+    (:func:`~digslam.observer.core.scalar_jit.imul_lo`, :func:`~digslam.observer.core.scalar_jit.imul_hi`)."""
+    return imul_lo(al, ah, bl, bh), imul_hi(al, ah, bl, bh)
 
 
 @njit
@@ -172,7 +174,7 @@ def clearance_cells(free: np.ndarray, grid: GridFrame, block: tuple[int, int, in
     ``win = (w0, w1, v0, v1)`` (which holds them) and its ring.
 
     The bound is ``D·keep - off`` with ``D`` the centre distance to the nearest not-free cell and the
-    constants of ``grid`` (:class:`.dig_jit.GridFrame`), as in :meth:`.digmap.DigMap.clearance_lower`.
+    constants of ``grid`` (:class:`.dig_types.GridFrame`), as in :meth:`.digmap.DigMap.clearance_lower`.
     """
     b0, b1, a0, a1 = block
     w0, w1, v0, v1 = win
@@ -213,7 +215,7 @@ def _not_free(free: np.ndarray, win: tuple[int, int, int, int]) -> tuple[np.ndar
 def _feasible(free: np.ndarray, i: int, j: int, r_hi: float, win: tuple[int, int, int, int], dx: float,
               dy: float, keep: float, off: float) -> bool:  # fmt: skip
     """Whether cell ``(i, j)`` may hold a pose: its :func:`clearance_cells` bound (on the window ``win``,
-    cell size ``dx``, ``dy``, constants ``keep``, ``off`` of :class:`.dig_jit.GridFrame`) is ``<= r⁺``.
+    cell size ``dx``, ``dy``, constants ``keep``, ``off`` of :class:`.dig_types.GridFrame`) is ``<= r⁺``.
 
     The bound is monotone in the distance, so the cell is feasible iff the ring or one not-free cell of the
     window is near enough; only the cells within the generous radius ``(r⁺ + off) / keep · (1 + 10⁻⁹)`` of

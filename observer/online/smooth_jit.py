@@ -31,7 +31,8 @@ import numpy as np
 
 from digslam.observer.core.scalar_jit import add_dn, add_up, njit, sub_dn, sub_up
 from digslam.observer.online.cones_jit import contract_cones
-from digslam.observer.online.dig_jit import CellSets, GridFrame, PoseBox, StepRecord, in_frame
+from digslam.observer.online.dig_jit import in_frame
+from digslam.observer.online.dig_types import CellSets, GridFrame, PoseBox, StepRecord
 from digslam.observer.online.mark_jit import dig_and_mark_q
 from digslam.observer.online.pose_jit import contract, impact_bound_q
 from digslam.observer.online.step_jit import CONE_MIN_WIDTH, filter_step_q
@@ -52,7 +53,7 @@ __all__ = [
 
 class RecordArrays(NamedTuple):
     """A stacked record of ``T + 1`` steps as the kernels read it (C-contiguous float64, ``no_echo`` bool):
-    the fields of :class:`.dig_jit.StepRecord` with a leading time axis, ``t`` (``(T + 1,)``) in place of
+    the fields of :class:`.dig_types.StepRecord` with a leading time axis, ``t`` (``(T + 1,)``) in place of
     ``dt`` (the same fields as :class:`~digslam.observer.record.mission.MissionRecord`, ``ranges`` for its
     ``range``)."""
 
@@ -79,7 +80,7 @@ def record_arrays(rec: MissionRecord) -> RecordArrays:
 
 @njit
 def step_at(rec: RecordArrays, k: int) -> StepRecord:
-    """Step ``k`` of a stacked record as a :class:`.dig_jit.StepRecord` (``dt = t_k - t_{k-1}``, 0 at
+    """Step ``k`` of a stacked record as a :class:`.dig_types.StepRecord` (``dt = t_k - t_{k-1}``, 0 at
     ``k = 0``, computed as the filter computes it)."""
     dt = rec.t[k] - rec.t[k - 1] if k > 0 else 0.0
     return StepRecord(dt, rec.speed[k], rec.lateral[k], rec.yaw_rate[k], rec.heading[k], rec.alpha[k],
@@ -95,7 +96,7 @@ def filter_record(cells: CellSets, grid: GridFrame, rec: RecordArrays, lo: np.nd
     steps ``k`` multiple of ``cone_every``, as :class:`.observer.OnlineDigSlam`).
 
     Args:
-        cells: the cell sets, updated in place (:class:`.dig_jit.CellSets`).
+        cells: the cell sets, updated in place (:class:`.dig_types.CellSets`).
         lo, hi, psi: ``(T + 1, 2)``, row 0 the start box and heading; receive every step's box and heading.
         d: ``(T + 1, 4)`` receives the displacement boxes ``(d_x⁻, d_y⁻, d_x⁺, d_y⁺)`` (row 0: NaN).
 

@@ -56,7 +56,7 @@ from typing import Any
 import numpy as np
 
 from digslam.observer.core.boxes import width_inf
-from digslam.observer.online.dig_jit import CellSets
+from digslam.observer.online.dig_types import CellSets
 from digslam.observer.online.smooth_jit import (
     contract_gates,
     filter_record,

@@ -1,7 +1,7 @@
 """One step of the online Dig-SLAM filter (thesis §6.4, Algorithm 6.3, Eq. 6.21–6.23) in one compiled call.
 
-:func:`filter_step` chains the kernels :meth:`.online.OnlineDigSlam.update` used to call one by one from
-Python, with the same arguments and the same results:
+:func:`filter_step` chains the kernels of one step of the filter
+(:meth:`~digslam.observer.online.observer.OnlineDigSlam.update`):
 
 1. :func:`.pose_jit.predict`: the tube step (``x' = R(ψ) v``, Eq. 3.59, 6.12, B.20, heading fused with
    the compass);
@@ -16,17 +16,18 @@ Python, with the same arguments and the same results:
 §2.6.2): step 2 then uses the q-relaxed impact radius and step 3 digs a cell only where ``q + 1`` readings
 prove it free; :func:`filter_step` is ``q = 0``.
 
-The inputs are the named tuples the caller builds, the filter's :class:`.dig_jit.CellSets` and
-:class:`.dig_jit.GridFrame` (once per episode) and the step's :class:`.dig_jit.StepRecord`, and the state:
+The inputs are the named tuples the caller builds, the filter's :class:`.dig_types.CellSets` and
+:class:`.dig_types.GridFrame` (once per episode) and the step's :class:`.dig_types.StepRecord`, and the state:
 three ``(2,)`` arrays holding the pose box and the heading interval of the previous step, which receive
 the new ones; the step's displacement box is returned. Nothing is rounded here: every bound comes from
-those kernels (outward rounded with :mod:`.jit`). (The state is not a named tuple on purpose: each named
-tuple costs about a microsecond at every call from Python, and this call runs at every step.)
+those kernels (outward rounded with :mod:`digslam.observer.core.scalar_jit`). (The state is not a named
+tuple on purpose: each named tuple costs about a microsecond at every call from Python, and this call runs
+at every step.)
 
 :func:`filter_step_flat` is :func:`filter_step_q` called from Python at every step
-(:meth:`.online.OnlineDigSlam.update`): it takes the three named tuples as plain tuples of their fields and
-builds them inside, which numba's dispatcher types several times faster (a named tuple argument is typed
-field by field in Python, a plain tuple in C: about 2.5 µs less per call for these three).
+(:meth:`~digslam.observer.online.observer.OnlineDigSlam.update`): it takes the three named tuples as plain
+tuples of their fields and builds them inside, which numba's dispatcher types several times faster (a named
+tuple argument is typed field by field in Python, a plain tuple in C).
 
 >>> from digslam.observer.online.window import grid_frame
 >>> from digslam.observer.record.grid import Grid
@@ -50,7 +51,8 @@ import numpy as np
 
 from digslam.observer.core.scalar_jit import njit
 from digslam.observer.online.cones_jit import contract_cones
-from digslam.observer.online.dig_jit import CellSets, GridFrame, PoseBox, StepRecord, in_frame
+from digslam.observer.online.dig_jit import in_frame
+from digslam.observer.online.dig_types import CellSets, GridFrame, PoseBox, StepRecord
 from digslam.observer.online.mark_jit import dig_and_mark_q
 from digslam.observer.online.pose_jit import contract, impact_bound_q, predict
 
@@ -69,9 +71,9 @@ def filter_step_q(cells: CellSets, grid: GridFrame, step: StepRecord, pose_lo: n
 
     Args:
         cells: the filter's cell sets ``M⁻``, certainly and possibly sensed (updated in place), and the
-            per-cell counts of the q-relaxed mode (:class:`.dig_jit.CellSets`; unused when ``q = 0``).
-        grid: the grid's cell bounds and the clearance bound's constants (:class:`.dig_jit.GridFrame`).
-        step: the step's record (:class:`.dig_jit.StepRecord`): odometry and readings.
+            per-cell counts of the q-relaxed mode (:class:`.dig_types.CellSets`; unused when ``q = 0``).
+        grid: the grid's cell bounds and the clearance bound's constants (:class:`.dig_types.GridFrame`).
+        step: the step's record (:class:`.dig_types.StepRecord`): odometry and readings.
         pose_lo, pose_hi, heading: ``(2,)`` the pose box ``[x⁻, y⁻]``, ``[x⁺, y⁺]`` and the heading interval
             ``[ψ⁻, ψ⁺]`` at the previous step, overwritten with the new ones when ``code`` is 0 (left as
             they are otherwise).
@@ -115,7 +117,7 @@ def filter_step_flat(cells: tuple, grid: tuple, step: tuple, pose_lo: np.ndarray
                      heading: np.ndarray, impacts: int, q: int
                      ) -> tuple[int, int, int, int, int, tuple[float, float, float, float]]:  # fmt: skip
     """:func:`filter_step_q` with ``cells``, ``grid`` and ``step`` the plain tuples of the fields of a
-    :class:`.dig_jit.CellSets`, a :class:`.dig_jit.GridFrame` and a :class:`.dig_jit.StepRecord` (all 11
+    :class:`.dig_types.CellSets`, a :class:`.dig_types.GridFrame` and a :class:`.dig_types.StepRecord` (all 11
     fields: ``tuple(StepRecord(...))``); same arguments otherwise, same results to the bit."""
     return filter_step_q(CellSets(*cells), GridFrame(*grid), StepRecord(*step), pose_lo, pose_hi, heading,
                          impacts, q)  # fmt: skip

@@ -13,13 +13,12 @@ Eq. 6.22 for one pose box (:meth:`WindowDigMap.contract_box`, :func:`.pose_jit.c
 *proved* to miss every sensed sector ``x + R(ψ)·{ρ <= r⁺, |θ - α| <= γ}`` for ``x ∈ [x]``, ``ψ ∈ [ψ]``:
 either its relative box ``c - [x]`` (outward rounded) misses the closed disk ``ρ <= r⁺``, or, for a cone of
 aperture at most ``π/2``, it lies strictly on the outer side of one of the cone's edges, or of an axis
-that bounds the cone (:func:`.dig_jit.mark_cells`). The certainly sensed cells (``Z⁻``) are exactly the
+that bounds the cone (:func:`.mark_jit.mark_cells`). The certainly sensed cells (``Z⁻``) are exactly the
 dug cells: a cell is dug when it lies in ``x + Z⁻`` for every pose.
 
-Rounding: every bound goes through the outward-rounded scalar kernels of :mod:`.jit` (one-ulp steps of each
-correctly rounded operation, libm ``cos``/``sin`` widened by ``LIBM_ULPS`` ulps). The previous numpy
-kernels (round-to-nearest tests against the relative margin :data:`MARGIN`) are kept as test oracles in
-``tests/observer/online/test_kernels.py``.
+Rounding: every bound goes through the outward-rounded scalar kernels of
+:mod:`digslam.observer.core.scalar_jit` (one-ulp steps of each correctly rounded operation, libm
+``cos``/``sin`` widened by ``LIBM_ULPS`` ulps).
 
 >>> g = Grid((-2.0, -2.0), (2.0, 2.0), (8, 8))
 >>> maybe = np.zeros(g.shape, bool)
@@ -39,15 +38,13 @@ from scipy.ndimage import distance_transform_edt
 
 from digslam.observer.core import rounding as rnd
 from digslam.observer.online import pose_jit
-from digslam.observer.online.dig_jit import GridFrame, PoseBox, SectorBatch, dig_batch
+from digslam.observer.online.dig_jit import dig_batch
+from digslam.observer.online.dig_types import GridFrame, PoseBox, SectorBatch
 from digslam.observer.online.mark_jit import mark_batch
 from digslam.observer.record.grid import Grid
 from digslam.observer.slam.digmap import EDT_SLACK, DigMap
 
-__all__ = ["WindowDigMap", "grid_frame", "mark_possibly_sensed", "MARGIN"]
-
-#: Relative margin of the former round-to-nearest pair tests (now only used by the test oracles).
-MARGIN = 1e-13
+__all__ = ["WindowDigMap", "grid_frame", "mark_possibly_sensed"]
 
 
 def _slack(grid: Grid) -> tuple[float, float]:
@@ -59,7 +56,7 @@ def _slack(grid: Grid) -> tuple[float, float]:
 
 
 def grid_frame(grid: Grid) -> GridFrame:
-    """The :class:`.dig_jit.GridFrame` of ``grid`` for the online kernels: writeable float64 copies of its
+    """The :class:`.dig_types.GridFrame` of ``grid`` for the online kernels: writeable float64 copies of its
     exact cell bounds (``xs``, ``ys``, ``nys = -ys``) and the constants ``keep = 1 - EDT_SLACK``,
     ``off = diag + EDT_SLACK·span`` of the clearance bound."""
     xs, ys = (np.array(v, dtype=np.float64) for v in (grid.xs, grid.ys))
@@ -78,7 +75,7 @@ class WindowDigMap(DigMap):
     def __init__(self, grid: Grid) -> None:
         super().__init__(grid)
         self._xs, self._nys = grid.xs.tolist(), (-grid.ys).tolist()
-        #: The grid as the online kernels read it (:func:`grid_frame`, :class:`.dig_jit.GridFrame`).
+        #: The grid as the online kernels read it (:func:`grid_frame`, :class:`.dig_types.GridFrame`).
         self.frame = grid_frame(grid)
         self.xs, self.ys, self.nys = self.frame.xs, self.frame.ys, self.frame.nys
         self.keep, self.off = self.frame.keep, self.frame.off

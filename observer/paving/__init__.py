@@ -7,49 +7,12 @@ regular grid) and :mod:`.draw` (matplotlib pictures of boxes and pavings; matplo
 May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.sets`; numpy, numba.
 """
 
-from .draw import (
-    BOUNDARY_COLOR,
-    CLEAR_COLOR,
-    DARK_COLOR,
-    INSIDE_COLOR,
-    OUTSIDE_COLOR,
-    PENUMBRA_COLOR,
-    draw_boxes,
-    draw_grid,
-    draw_paving,
-    draw_polygon,
-    new_figure,
-    save_figure,
-)
-from .paver import (
-    Paving,
-    PavingTree,
-    connected_subsets,
-    pave,
-)
-from .paver_jit import (
-    pave_generation,
-)
-from .regular import (
-    classify_grid,
-)
-from .subpaving import (
-    SepSubpaving,
-    load,
-    save,
-    simplify,
-)
+from .draw import draw_boxes, draw_grid, draw_paving, draw_polygon, new_figure, save_figure
+from .paver import Paving, PavingTree, connected_subsets, pave
+from .regular import classify_grid
+from .subpaving import SepSubpaving, load, save, simplify
 
 __all__ = [
-    "BOUNDARY_COLOR",
-    "CLEAR_COLOR",
-    "DARK_COLOR",
-    "INSIDE_COLOR",
-    "OUTSIDE_COLOR",
-    "PENUMBRA_COLOR",
-    "Paving",
-    "PavingTree",
-    "SepSubpaving",
     "classify_grid",
     "connected_subsets",
     "draw_boxes",
@@ -59,8 +22,10 @@ __all__ = [
     "load",
     "new_figure",
     "pave",
-    "pave_generation",
     "save",
     "save_figure",
     "simplify",
+    "Paving",
+    "PavingTree",
+    "SepSubpaving",
 ]

@@ -17,13 +17,15 @@ backend), so drawing works headless (matplotlib is the ``viz`` extra, so this is
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
+from digslam.observer.core.types import Batch
+
 __all__ = [
     "INSIDE_COLOR", "OUTSIDE_COLOR", "BOUNDARY_COLOR", "CLEAR_COLOR", "PENUMBRA_COLOR", "DARK_COLOR",
-    "new_figure", "draw_boxes", "draw_paving", "draw_grid", "draw_polygon", "save_figure",
+    "Paved", "new_figure", "draw_boxes", "draw_paving", "draw_grid", "draw_polygon", "save_figure",
 ]  # fmt: skip
 
 #: thesis colours: inside (X⁻) red, outside blue, undetermined (ΔX) yellow
@@ -34,6 +36,20 @@ BOUNDARY_COLOR = "#ffd700"
 CLEAR_COLOR = "#e41a1c"
 PENUMBRA_COLOR = "#ff8c00"
 DARK_COLOR = "#08306b"
+
+
+class Paved(Protocol):
+    """What :func:`draw_paving` draws: a :class:`~digslam.observer.paving.paver.Paving` or anything with its
+    three ``(lo, hi)`` batches."""
+
+    @property
+    def inner(self) -> Batch: ...
+
+    @property
+    def outer(self) -> Batch: ...
+
+    @property
+    def boundary(self) -> Batch: ...
 
 
 def new_figure(ncols: int = 1, nrows: int = 1, size: float = 5.0, **subplots_kw: Any) -> tuple[Any, Any]:
@@ -104,7 +120,7 @@ def draw_boxes(
 
 
 def draw_paving(
-    paving: Any,
+    paving: Paved,
     ax: Any = None,
     inner_color: Any = INSIDE_COLOR,
     outer_color: Any = OUTSIDE_COLOR,

@@ -7,9 +7,7 @@ cones, ``SepLandmark``, Sec. 4.3-4.4).
 May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.expr`, :mod:`digslam.observer.sets`; numpy.
 """
 
-from .ctc import (
-    CtcPolar,
-)
+from .ctc import CtcPolar
 from .sep import (
     SepCtcPreimage,
     SepLandmark,
@@ -17,18 +15,16 @@ from .sep import (
     SepPiInv,
     SepPolarXY,
     complement_boxes,
-    project_contract,
     sep_landmark_fwdbwd,
 )
 
 __all__ = [
+    "complement_boxes",
+    "sep_landmark_fwdbwd",
     "CtcPolar",
     "SepCtcPreimage",
     "SepLandmark",
     "SepPi",
     "SepPiInv",
     "SepPolarXY",
-    "complement_boxes",
-    "project_contract",
-    "sep_landmark_fwdbwd",
 ]

@@ -146,7 +146,7 @@ class MissionRecord:
     def __eq__(self, other: object) -> bool:
         return isinstance(other, MissionRecord) and self.same_as(other)
 
-    __hash__ = None  # type: ignore[assignment]
+    __hash__ = None  # type: ignore[assignment]  # compared by value (same_as), arrays inside: unhashable
 
     def as_dict(self) -> dict[str, np.ndarray]:
         """Field name to array."""

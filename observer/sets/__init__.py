@@ -11,29 +11,13 @@ any separator).
 May import: :mod:`digslam.observer.core`, :mod:`digslam.observer.expr`; numpy, numba.
 """
 
-from .contractors import (
-    Ctc,
-    CtcCompose,
-    CtcFixPoint,
-    CtcFwdBwd,
-    CtcInter,
-    CtcUnion,
-    forward,
-    hc4_backward,
-)
-from .minkowski import (
-    SepMinkowskiDiff,
-    SepMinkowskiSum,
-    sep_negate,
-)
-from .projection import (
-    SepOnDims,
-    SepProj,
-    bounded_box,
-)
+from .contractors import Ctc, CtcCompose, CtcFixPoint, CtcFwdBwd, CtcInter, CtcUnion
+from .minkowski import SepMinkowskiDiff, SepMinkowskiSum, sep_negate
+from .projection import SepOnDims, SepProj
 from .registration import (
     ParamTransform,
     SepRegistration,
+    Transformation,
     rigid2d,
     scaling,
     sep_cone,
@@ -42,19 +26,9 @@ from .registration import (
     transform_function,
     translation,
 )
-from .sep_image import (
-    CtcImage,
-    SepImage,
-)
-from .sep_inverse import (
-    SepInverse,
-)
-from .sep_polygon import (
-    CtcPolygonBoundary,
-    CtcSegments,
-    SepPolygon,
-    orient,
-)
+from .sep_image import CtcImage, SepImage
+from .sep_inverse import SepInverse
+from .sep_polygon import CtcPolygonBoundary, CtcSegments, SepPolygon
 from .separators import (
     Sep,
     SepBox,
@@ -65,25 +39,26 @@ from .separators import (
     SepUnion,
     box_qinter,
     check_separation,
-    hull_batch,
-    inter_batch,
     relaxed_intersection,
 )
-from .separators_jit import (
-    fold_separated,
-)
-from .testing import (
-    assert_separator_sound,
-    random_boxes,
-)
-from .transforms import (
-    CtcTransform,
-    SepTransform,
-    Transform,
-    symmetric_union,
-)
+from .testing import assert_separator_sound, random_boxes
+from .transforms import CtcTransform, SepTransform, Transform, symmetric_union
 
 __all__ = [
+    "assert_separator_sound",
+    "box_qinter",
+    "check_separation",
+    "random_boxes",
+    "relaxed_intersection",
+    "rigid2d",
+    "scaling",
+    "sep_cone",
+    "sep_inclusion",
+    "sep_intersection",
+    "sep_negate",
+    "symmetric_union",
+    "transform_function",
+    "translation",
     "Ctc",
     "CtcCompose",
     "CtcFixPoint",
@@ -112,25 +87,5 @@ __all__ = [
     "SepTransform",
     "SepUnion",
     "Transform",
-    "assert_separator_sound",
-    "bounded_box",
-    "box_qinter",
-    "check_separation",
-    "fold_separated",
-    "forward",
-    "hc4_backward",
-    "hull_batch",
-    "inter_batch",
-    "orient",
-    "random_boxes",
-    "relaxed_intersection",
-    "rigid2d",
-    "scaling",
-    "sep_cone",
-    "sep_inclusion",
-    "sep_intersection",
-    "sep_negate",
-    "symmetric_union",
-    "transform_function",
-    "translation",
+    "Transformation",
 ]

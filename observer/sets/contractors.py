@@ -13,6 +13,7 @@ solution. Empty results are rows ``[+inf, -inf]``. ``&`` is the intersection ``C
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -159,7 +160,7 @@ class CtcFwdBwd(Ctc):
     linear forward-backward on the mean-value form, as in codac's ``CtcInverse``).
     """
 
-    def __init__(self, f: Function | Any, y: Any, centred: bool = False) -> None:
+    def __init__(self, f: Function | Callable[..., Any], y: Any, centred: bool = False) -> None:
         self.centred = bool(centred)
         self.f = f if isinstance(f, Function) else Function(f)
         self.n = self.f.n

@@ -145,11 +145,9 @@ class SepProj(Sep):
             Proj-union / Proj-intersection of [Chabert and Jaulin, 2009b] contract to a fixpoint):
             ``x_out ← S_out(x_out)`` and ``x_in ← S_in(x_in)``, each round on the boxes still shrinking
             by more than ``fixpoint_ratio`` of their perimeter, at most ``max_rounds`` rounds. A smaller
-            ``[x]`` contracts every split further, so this is tighter, at the cost of more calls. Off by
-            default: on codac's SepProj test it takes the bound of the second box from 1.249 to 1.200 at
-            3.4× the time of one call, and a paving of that projection over [-2, 2]² at ε = 0.1 takes
-            about 8× the time (``benchmarks/bench_paver.py``, ``sepproj_fixpoint_*``): inside a paver,
-            bisecting the box pays more than contracting it again.
+            ``[x]`` contracts every split further, so this is tighter, at the cost of more calls (one
+            per round; ``benchmarks/bench_paver.py``, ``sepproj_fixpoint_*``, measures both). Off by
+            default: inside a paver, bisecting the box pays more than contracting it again.
         fixpoint_ratio, max_rounds: the stopping rule of the fixpoint (as :class:`~.contractors.CtcFixPoint`).
 
     Raises:

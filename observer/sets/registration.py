@@ -23,7 +23,7 @@ only sees ``a ∈ a_box``). ``f`` is traced on ``z = (a₁..aₙ, p₁..p_q)``; 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import Any, TypeAlias
 
 import numpy as np
 
@@ -35,12 +35,15 @@ from digslam.observer.sets.sep_inverse import SepInverse
 from digslam.observer.sets.separators import Sep, SepInter, SepNot
 
 __all__ = [
-    "ParamTransform", "SepRegistration", "sep_inclusion", "sep_intersection", "sep_cone", "translation",
-    "rigid2d", "scaling", "transform_function",
+    "ParamTransform", "Transformation", "SepRegistration", "sep_inclusion", "sep_intersection", "sep_cone",
+    "translation", "rigid2d", "scaling", "transform_function",
 ]  # fmt: skip
 
 #: a parametric transformation ``f(a, p)`` on expressions: the point ``a`` moved by the parameter ``p``
 ParamTransform = Callable[[Sequence[Expr], Sequence[Expr]], Any]
+#: what the registration separators take as ``f``: a :data:`ParamTransform` (with ``q`` given, or
+#: ``f.q``) or a :class:`~digslam.observer.expr.expr.Function` of ``z = (a, p)``
+Transformation: TypeAlias = ParamTransform | Function
 
 
 def translation(n: int) -> ParamTransform:
@@ -51,7 +54,7 @@ def translation(n: int) -> ParamTransform:
     def f(a: Sequence[Expr], p: Sequence[Expr]) -> tuple[Expr, ...]:
         return tuple(a[i] + p[i] for i in range(n))
 
-    f.q = n  # type: ignore[attr-defined]
+    f.q = n  # type: ignore[attr-defined]  # the parameter count rides on f (transform_function reads f.q)
     return f
 
 
@@ -63,7 +66,7 @@ def rigid2d() -> ParamTransform:
         c, s = cos(p[2]), sin(p[2])
         return (a[0] * c - a[1] * s + p[0], a[0] * s + a[1] * c + p[1])
 
-    f.q = 3  # type: ignore[attr-defined]
+    f.q = 3  # type: ignore[attr-defined]  # as in translation
     return f
 
 
@@ -73,11 +76,11 @@ def scaling() -> ParamTransform:
     def f(a: Sequence[Expr], p: Sequence[Expr]) -> tuple[Expr, ...]:
         return tuple(p[0] * ai for ai in a)
 
-    f.q = 1  # type: ignore[attr-defined]
+    f.q = 1  # type: ignore[attr-defined]  # as in translation
     return f
 
 
-def transform_function(f: ParamTransform | Function, n: int, q: int, m: int | None) -> Function:
+def transform_function(f: Transformation, n: int, q: int, m: int | None) -> Function:
     """``f`` as a :class:`Function` of ``z = (a, p) ∈ R^(n+q)``, checked to have ``m`` outputs.
 
     Args:
@@ -134,7 +137,7 @@ class SepRegistration(Sep):
         self,
         sep_a: Sep,
         sep_b: Sep,
-        f: ParamTransform | Function,
+        f: Transformation,
         a_box: Any,
         eps: float,
         mode: str = "inclusion",
@@ -166,16 +169,12 @@ class SepRegistration(Sep):
         return self.sep.separate(lo, hi)
 
 
-def sep_inclusion(
-    sep_a: Sep, sep_b: Sep, f: ParamTransform | Function, a_box: Any, eps: float, **kw: Any
-) -> Sep:
+def sep_inclusion(sep_a: Sep, sep_b: Sep, f: Transformation, a_box: Any, eps: float, **kw: Any) -> Sep:
     """Separator of ``{p | f(A, p) ⊂ B}`` (Eq. 4.13, 4.16); see :class:`SepRegistration`."""
     return SepRegistration(sep_a, sep_b, f, a_box, eps, mode="inclusion", **kw)
 
 
-def sep_intersection(
-    sep_a: Sep, sep_b: Sep, f: ParamTransform | Function, a_box: Any, eps: float, **kw: Any
-) -> Sep:
+def sep_intersection(sep_a: Sep, sep_b: Sep, f: Transformation, a_box: Any, eps: float, **kw: Any) -> Sep:
     """Separator of ``{p | f(A, p) ∩ B ≠ ∅}`` (Eq. 4.19–4.20); see :class:`SepRegistration`."""
     return SepRegistration(sep_a, sep_b, f, a_box, eps, mode="intersection", **kw)
 

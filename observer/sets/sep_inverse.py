@@ -14,6 +14,7 @@ or any separator in the image space. When ``f`` has a :class:`~.tape_jit.Tape` (
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -47,7 +48,7 @@ class SepInverse(Sep):
         ValueError: if ``y``'s dimension is not ``m``.
     """
 
-    def __init__(self, f: Function | Any, y: Any, centred: bool = False) -> None:
+    def __init__(self, f: Function | Callable[..., Any], y: Any, centred: bool = False) -> None:
         self.centred = bool(centred)
         self.f = f if isinstance(f, Function) else Function(f)
         self.n = self.f.n

@@ -22,6 +22,7 @@ import numpy as np
 from digslam.observer.core.boxes import empty_rows, normalize_empty, validate_batch
 from digslam.observer.core.interval import IntervalArray, as_pair
 from digslam.observer.core.types import Batch
+from digslam.observer.sets.contractors import Ctc
 from digslam.observer.sets.separators_jit import fold_separated
 
 
@@ -285,10 +286,12 @@ class SepCtcPair(Sep):
         ValueError: when both are None or their dimensions differ.
     """
 
-    def __init__(self, ctc_in: Any, ctc_out: Any) -> None:
+    def __init__(self, ctc_in: Ctc | None, ctc_out: Ctc | None) -> None:
         if ctc_in is None and ctc_out is None:
             raise ValueError("ctc_in, ctc_out: give at least one contractor")
-        dims = {c.n for c in (ctc_in, ctc_out) if c is not None and getattr(c, "n", None) is not None}
+        dims: set[int] = {
+            n for c in (ctc_in, ctc_out) if c is not None and (n := getattr(c, "n", None)) is not None
+        }
         if len(dims) > 1:
             raise ValueError(f"ctc_in, ctc_out: mismatched dimensions {sorted(dims)}")
         self.ctc_in, self.ctc_out = ctc_in, ctc_out

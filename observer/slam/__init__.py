@@ -4,59 +4,28 @@ Lives here: :mod:`.digmap` (``DigMap``, the dig zone M-, Sec. 6.3),
 :mod:`.digslam` (Dig-SLAM's settings, result and tube pieces, and Alg. 6.3 as the thesis writes it),
 :mod:`.explored` and :mod:`.explored_sweep` (the explored zone as a thick set, App. B.5), :mod:`.landmarks`
 (landmark localization, Ex. 3.4), :mod:`.shapes` (sonar measurement shapes), :mod:`.shape_registration` and
-:mod:`.shape_slam` (shape SLAM, Sec. 6.4) and :mod:`.explicit_slam` (explicit SLAM, Alg. 6.1). The offline
-Dig-SLAM observer itself, ``dig_slam``, runs the online filter's kernels: :mod:`digslam.observer.online`.
+:mod:`.shape_slam` (shape SLAM, Sec. 6.4) and explicit SLAM (Alg. 6.1): :mod:`.explicit_slam` (the
+algorithm, its settings and result), :mod:`.thick_map` (the thick map and the map function),
+:mod:`.raster_shape` (a thick shape on a pixel raster), :mod:`.shape_srac` (carving and registration with a
+raster shape, Prop. 5.3-5.4) and :mod:`.measurements` (the families of measurements it iterates on). The
+offline Dig-SLAM observer itself, ``dig_slam``, runs the online filter's kernels:
+:mod:`digslam.observer.online`.
 
 May import: every folder of :mod:`digslam.observer` except :mod:`~digslam.observer.online`; numpy, scipy.
 """
 
-from .digmap import (
-    EDT_SLACK,
-    DigMap,
-)
-from .digslam import (
-    DigSlamConfig,
-    DigSlamResult,
-    dig_readings,
-    explored_zone,
-    impact_bound,
-    odometry_velocity,
-    thesis_dig_slam,
-)
-from .explicit_slam import (
-    ExplicitSlamConfig,
-    ExplicitSlamResult,
-    MapFunction,
-    Measurements,
-    RangeMeasurements,
-    RasterShape,
-    SepShapeRegistration,
-    ShapeMeasurements,
-    ThickMap,
-    explicit_slam,
-    mission_tube,
-    shape_carve,
-    shape_register,
-)
+from .digmap import DigMap
+from .digslam import DigSlamConfig, DigSlamResult, explored_zone, thesis_dig_slam
+from .explicit_slam import ExplicitSlamConfig, ExplicitSlamResult, explicit_slam, mission_tube
 from .explored import (
-    BLOCK,
     SepExploredDisks,
-    check_interval,
-    check_tube,
-    codes,
     explored_disks_grid,
     explored_disks_thick_sep,
     explored_hypotheses,
     explored_thick_sep,
     explored_union,
-    pair_test,
-    row_intervals,
 )
-from .explored_sweep import (
-    explored_sectors_grid,
-    explored_sweep_grid,
-    sweep_gates,
-)
+from .explored_sweep import explored_sectors_grid, explored_sweep_grid, sweep_gates
 from .landmarks import (
     CtcLandmarks,
     IterationStats,
@@ -65,32 +34,19 @@ from .landmarks import (
     contract_disjunctive,
     localize,
 )
-from .shape_registration import (
-    SepTranslationInclusion,
-    ThickImage,
-    level_thick_image,
-    register_translation,
-)
-from .shape_slam import (
-    ShapeSlamConfig,
-    ShapeSlamResult,
-    ctc_minus,
-    overlap_pretest,
-    shape_slam,
-)
-from .shapes import (
-    free_zone,
-    impact_zone,
-    measurement_shapes,
-)
+from .measurements import Measurements, RangeMeasurements, ShapeMeasurements
+from .raster_shape import RasterShape
+from .shape_registration import SepTranslationInclusion, ThickImage, level_thick_image, register_translation
+from .shape_slam import ShapeSlamConfig, ShapeSlamResult, ctc_minus, overlap_pretest, shape_slam
+from .shape_srac import SepShapeRegistration, shape_carve, shape_register
+from .shapes import free_zone, impact_zone, measurement_shapes
+from .thick_map import MapFunction, ThickMap
 
 __all__ = [
-    "BLOCK",
     "CtcLandmarks",
     "DigMap",
     "DigSlamConfig",
     "DigSlamResult",
-    "EDT_SLACK",
     "ExplicitSlamConfig",
     "ExplicitSlamResult",
     "IterationStats",
@@ -107,14 +63,9 @@ __all__ = [
     "ShapeSlamResult",
     "ThickImage",
     "ThickMap",
-    "check_interval",
-    "check_tube",
-    "codes",
     "contract_detections",
     "contract_disjunctive",
     "ctc_minus",
-    "dig_readings",
-    "thesis_dig_slam",
     "explicit_slam",
     "explored_disks_grid",
     "explored_disks_thick_sep",
@@ -125,19 +76,16 @@ __all__ = [
     "explored_union",
     "explored_zone",
     "free_zone",
-    "impact_bound",
     "impact_zone",
     "level_thick_image",
     "localize",
     "measurement_shapes",
     "mission_tube",
-    "odometry_velocity",
     "overlap_pretest",
-    "pair_test",
     "register_translation",
-    "row_intervals",
     "shape_carve",
     "shape_register",
     "shape_slam",
     "sweep_gates",
+    "thesis_dig_slam",
 ]

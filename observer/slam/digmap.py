@@ -251,6 +251,7 @@ class DigMap:
                 self._contract_chunk(lo, hi, act[idx], r0[idx], c0[idx], nr[idx], nc[idx], wr, wc, dlow, r_hi)
         return lo, hi
 
+    # the body of contract_impacts' loop over chunks of boxes, on its arrays (untyped: eleven of them)
     def _contract_chunk(self, lo, hi, box, r0, c0, nr, nc, wr, wc, dlow, r_hi) -> None:  # type: ignore[no-untyped-def]
         g = self.grid
         ny, nx = g.shape

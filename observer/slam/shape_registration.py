@@ -9,9 +9,9 @@ share their pixel edges and a translation moves whole lattice windows.
 
 :func:`register_translation` contracts ``[p]`` for ``Z(t_i) = Z(t_j) + p`` (constraint 2 of the CN of §6.3.2)
 by ``C_f=`` of Remark 5.7 (Eq. 5.54–5.56): ``p`` stays unless ``A⁻ + p ⊄ B⁺`` or ``B⁻ - p ⊄ A⁺`` is proved,
-``[p]`` being paved by :func:`~.thick_carving.param_hull` with the lattice separators
+``[p]`` being paved by :func:`~digslam.observer.thick.carving.param_hull` with the lattice separators
 :class:`SepTranslationInclusion` (``method="image"``), or with the generic projection separators of §4.2.2
-(``method="projection"``, :func:`~.thick_carving.ctc_param_equal`).
+(``method="projection"``, :func:`~digslam.observer.thick.carving.ctc_param_equal`).
 
 >>> z = np.array([[0.0, 0.0, 5.0, 5.0]] * 2)                  # a step: z <= 1 on the left half
 >>> a = level_thick_image(z, 0.1, 1.0, cell=1.0, corner=(0, 1))
@@ -103,7 +103,7 @@ class ThickImage:
 
     @property
     def shape(self) -> tuple[int, int]:
-        return self.lower.shape  # type: ignore[return-value]
+        return self.lower.shape  # type: ignore[return-value]  # 2-d (checked): numpy says tuple[int, ...]
 
     @property
     def origin(self) -> tuple[float, float]:
@@ -333,7 +333,7 @@ def _unshift(b: Any, p: Any) -> tuple[Any, Any]:
     return b[0] - p[0], b[1] - p[1]
 
 
-_shift.q = _unshift.q = 2  # type: ignore[attr-defined]
+_shift.q = _unshift.q = 2  # type: ignore[attr-defined]  # the parameter count rides on the function
 
 
 def register_translation(a: ThickImage, b: ThickImage, p_box: Any, eps_p: float, method: str = "image",

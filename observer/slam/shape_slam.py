@@ -46,7 +46,7 @@ def ctc_minus(xi: Pair, xj: Pair, p: Pair) -> tuple[Pair, Pair, Pair]:
     p = arith.intersect(p, arith.sub(xj, xi))
     xj = arith.intersect(xj, arith.add(xi, p))
     xi = arith.intersect(xi, arith.sub(xj, p))
-    return tuple(_norm(b) for b in (xi, xj, p))  # type: ignore[return-value]
+    return _norm(xi), _norm(xj), _norm(p)
 
 
 def _norm(b: Pair) -> Pair:

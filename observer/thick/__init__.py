@@ -30,7 +30,6 @@ from .interval import (
     TRUE,
     ThickIntervalArray,
     thin,
-    tri_state,
 )
 from .inversion import (
     SepFixedParam,
@@ -105,5 +104,4 @@ __all__ = [
     "thick_sivia",
     "thick_sivia_subset_supset",
     "thin",
-    "tri_state",
 ]

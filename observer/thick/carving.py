@@ -33,7 +33,12 @@ from digslam.observer.core.boxes import bisect, empty_rows, normalize_empty, wid
 from digslam.observer.core.interval import IntervalArray
 from digslam.observer.core.types import Batch
 from digslam.observer.sets.projection import bounded_box
-from digslam.observer.sets.registration import sep_inclusion, sep_intersection, transform_function
+from digslam.observer.sets.registration import (
+    Transformation,
+    sep_inclusion,
+    sep_intersection,
+    transform_function,
+)
 from digslam.observer.sets.separators import Sep, inter_batch
 from digslam.observer.sets.transforms import Transform
 from digslam.observer.thick.inversion import thick_inverse_proj
@@ -142,8 +147,8 @@ def _box(b: Batch) -> IntervalArray:
     return IntervalArray._raw(b[0].copy(), b[1].copy())
 
 
-def ctc_param_subset(p_box: Any, a: ThickSep, b: ThickSep, f: Any, a_box: Any, eps: float, eps_p: float,
-                     presplit: int = 0, **proj_kw: Any) -> Batch:  # fmt: skip
+def ctc_param_subset(p_box: Any, a: ThickSep, b: ThickSep, f: Transformation, a_box: Any, eps: float,
+                     eps_p: float, presplit: int = 0, **proj_kw: Any) -> Batch:  # fmt: skip
     """``C_f⊂([p], [A], [B]) = [p] ∩ ⟦{p | f_p(A⁻) ⊂ B⁺}⟧`` (Prop. 5.4, Eq. 5.49, 5.54).
 
     Args:
@@ -162,8 +167,9 @@ def ctc_param_subset(p_box: Any, a: ThickSep, b: ThickSep, f: Any, a_box: Any, e
     return param_hull(sep_inclusion(a.lower, b.upper, f, a_box, eps, **proj_kw), p_box, eps_p, presplit)
 
 
-def ctc_param_equal(p_box: Any, a: ThickSep, b: ThickSep, f: Any, f_inv: Any, a_box: Any, b_box: Any,
-                    eps: float, eps_p: float, presplit: int = 0, **proj_kw: Any) -> Batch:  # fmt: skip
+def ctc_param_equal(p_box: Any, a: ThickSep, b: ThickSep, f: Transformation, f_inv: Transformation,
+                    a_box: Any, b_box: Any, eps: float, eps_p: float, presplit: int = 0,
+                    **proj_kw: Any) -> Batch:  # fmt: skip
     """``C_f= = C_f⊂([p], [A], [B]) ∩ C_f⁻¹⊂([p], [B], [A])`` for bijective ``f_p`` (Remark 5.7, Eq. 5.56).
 
     Both inclusions ``f_p(A⁻) ⊂ B⁺`` and ``f_p⁻¹(B⁻) ⊂ A⁺`` are separated together and ``[p]`` is paved
@@ -175,8 +181,8 @@ def ctc_param_equal(p_box: Any, a: ThickSep, b: ThickSep, f: Any, f_inv: Any, a_
     return param_hull(seps, p_box, eps_p, presplit)
 
 
-def ctc_param_meets(p_box: Any, a: ThickSep, b: ThickSep, f: Any, a_box: Any, eps: float, eps_p: float,
-                    presplit: int = 0, **proj_kw: Any) -> Batch:  # fmt: skip
+def ctc_param_meets(p_box: Any, a: ThickSep, b: ThickSep, f: Transformation, a_box: Any, eps: float,
+                    eps_p: float, presplit: int = 0, **proj_kw: Any) -> Batch:  # fmt: skip
     """``C_f≠([p]) = [p] ∩ ⟦proj_p{(A⁺ × R^q) ∩ f⁻¹(B⁺)}⟧`` for ``f_p(A) ∩ B ≠ ∅`` (Prop. 5.5, Eq. 5.61).
 
     ``a_box`` must contain ``A⁺``: the projection only sees ``a ∈ a_box`` (a smaller box could drop a
@@ -196,8 +202,9 @@ def ctc_image_equal(a: ThickSep, b: ThickSep, t: Transform) -> tuple[ThickSep, T
     return a2, b2
 
 
-def ctc_image_param(a: ThickSep, b: ThickSep, f: Any, f_inv: Any, p_box: Any, *, n: int, eps: float,
-                    equal: bool = True, q: int | None = None) -> tuple[ThickSep, ThickSep]:  # fmt: skip
+def ctc_image_param(a: ThickSep, b: ThickSep, f: Transformation, f_inv: Transformation, p_box: Any, *,
+                    n: int, eps: float, equal: bool = True, q: int | None = None
+                    ) -> tuple[ThickSep, ThickSep]:  # fmt: skip
     """Carving by ``f_p(A) = B`` (or ``⊂``), ``p ∈ [p]``, ``f_p`` bijective (Prop. 5.3, Eq. 5.48).
 
     ``F⁻¹([B]) = [∩_p f_p⁻¹(B⁻), ∪_p f_p⁻¹(B⁺)]`` and ``F([A]) = [∩_p f_p(A⁻), ∪_p f_p(A⁺)]`` (Theorem 5.1,
@@ -230,8 +237,8 @@ class SRACResult:
     stats: dict[str, Any] = field(default_factory=dict)
 
 
-def srac(f: Any, f_inv: Any, p_box: Any, a: ThickSep, b: ThickSep, a_box: Any, b_box: Any, *, eps: float,
-         eps_p: float, eps_carve: float | None = None, presplit: int = 0,
+def srac(f: Transformation, f_inv: Transformation, p_box: Any, a: ThickSep, b: ThickSep, a_box: Any,
+         b_box: Any, *, eps: float, eps_p: float, eps_carve: float | None = None, presplit: int = 0,
          **proj_kw: Any) -> SRACResult:  # fmt: skip
     """Shape registration and carving, Algorithm 5.1, for ``f_p(A) = B`` with ``f_p`` bijective.
 

@@ -19,6 +19,7 @@ boxes in the penumbra and adds pessimism (Fig. 5.7b).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -26,6 +27,7 @@ import numpy as np
 from digslam.observer.core.boxes import normalize_empty
 from digslam.observer.core.interval import IntervalArray
 from digslam.observer.core.types import Batch
+from digslam.observer.expr.expr import Function
 from digslam.observer.sets.projection import SepProj
 from digslam.observer.sets.sep_inverse import SepInverse
 from digslam.observer.sets.separators import Sep, SepNot
@@ -64,8 +66,8 @@ class SepFixedParam(Sep):
         return normalize_empty(ilo[:, :n], ihi[:, :n]), normalize_empty(olo[:, :n], ohi[:, :n])
 
 
-def thick_inverse_proj(f: Any, y_lower: Any, y_upper: Any, p_box: Any = None, *, n: int, eps: float,
-                       p: Any = None) -> ThickSep:  # fmt: skip
+def thick_inverse_proj(f: Function | Callable[..., Any], y_lower: Any, y_upper: Any, p_box: Any = None, *,
+                       n: int, eps: float, p: Any = None) -> ThickSep:  # fmt: skip
     """Thick separator of ``[X⁻, X⁺]`` of Eq. 5.40–5.41 via projection.
 
     Args:
@@ -87,7 +89,9 @@ def thick_inverse_proj(f: Any, y_lower: Any, y_upper: Any, p_box: Any = None, *,
     return ThickSep(lower, upper)
 
 
-def thick_inverse_classical(f: Any, y_lower: Any, y_upper: Any, p_box: Any, *, n: int) -> ThickSep:
+def thick_inverse_classical(
+    f: Function | Callable[..., Any], y_lower: Any, y_upper: Any, p_box: Any, *, n: int
+) -> ThickSep:
     """Classical thick separator: ``[p]`` stays an interval inside ``f`` (Fig. 5.7b)."""
     lower = SepFixedParam(SepInverse(f, y_lower), p_box, n)
     return ThickSep(lower, SepFixedParam(SepInverse(f, y_upper), p_box, n))

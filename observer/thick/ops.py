@@ -27,7 +27,7 @@ from typing import Any
 
 from digslam.observer.sets.minkowski import SepMinkowskiSum
 from digslam.observer.sets.projection import SepOnDims, bounded_box
-from digslam.observer.sets.registration import ParamTransform, transform_function
+from digslam.observer.sets.registration import Transformation, transform_function
 from digslam.observer.sets.separators import Sep, SepInter
 from digslam.observer.sets.transforms import SepTransform, Transform
 from digslam.observer.thick.inversion import thick_inverse_proj
@@ -58,12 +58,12 @@ def thick_image(a: ThickSep, t: Transform) -> ThickSep:
     return ThickSep(SepTransform(a.lower, t), SepTransform(a.upper, t))
 
 
-def thick_image_param(a: ThickSep, f_inv: ParamTransform | Any, p_box: Any, *, n: int, eps: float,
+def thick_image_param(a: ThickSep, f_inv: Transformation, p_box: Any, *, n: int, eps: float,
                       q: int | None = None) -> ThickSep:  # fmt: skip
     """``f_[p]([A]) = [∩_{p∈[p]} f_p(A⁻), ∪_{p∈[p]} f_p(A⁺)]`` for bijections ``f_p`` (Eq. 5.13, 5.40–5.41).
 
     With ``g_p = f_p⁻¹``, ``f_p(A) = g_p⁻¹(A)``: the bounds are the uncertain inversion of ``[A]`` by
-    ``g`` (:func:`~.thick_inversion.thick_inverse_proj`), projections over ``[p]``.
+    ``g`` (:func:`~.inversion.thick_inverse_proj`), projections over ``[p]``.
 
     Args:
         a: the thick set ``[A]`` (on ``Rⁿ``).

@@ -1,7 +1,7 @@
 """ThickSivia: thick set inversion ``⟦X⟧ = [f]⁻¹(⟦Y⟧)`` (thesis App. A, Algorithm A.2, Theorem A.2).
 
 ``[f] = [f⁻, f⁺]`` is a thick function (§A.2) given by a thick inclusion function ``⟦f⟧``
-(Theorem A.1, :class:`~.thick_function.ThickFunction`) and ``⟦Y⟧ = [Y⁻, Y⁺]`` a thick set made of two
+(Theorem A.1, :class:`~.function.ThickFunction`) and ``⟦Y⟧ = [Y⁻, Y⁺]`` a thick set made of two
 boxes ``Y⁻ ⊂ Y⁺``. Pointwise ``X⁻ = {x | [f](x) ⊂ Y⁻}`` and ``X⁺ = {x | [f](x) ∩ Y⁺ ≠ ∅}`` (Eq. 5.32,
 A.36). For a box ``[x]`` and ``⟦a⟧ = ⟦f⟧([x])`` (Prop. A.1, A.2 on thick boxes):
 
@@ -11,7 +11,7 @@ A.36). For a box ``[x]`` and ``⟦a⟧ = ⟦f⟧([x])`` (Prop. A.1, A.2 on thick
   ``[x] ⊂ X⁺ \\ X⁻`` (Theorem A.2 iii; this is implied by the test ``(⟦a⟧ ∩ (Y⁺\\Y⁻) ≠ ∅)^∀`` of
   Algorithm A.2 and proves at least as many boxes).
 
-Boxes proved in the penumbra are never bisected (:func:`~.thick_paver.thick_pave`, one generation of
+Boxes proved in the penumbra are never bisected (:func:`~.paver.thick_pave`, one generation of
 boxes per call). Example A.1: ``f(x) = ‖x − a‖²``, ``a ∈ [0, 1]²``, ``[y] = [0, 4]``, so
 ``area(X⁻) ≈ 5.647`` (four disks meet) and ``area(X⁺) = 9 + 4π ≈ 21.566`` (a rounded square):
 
@@ -202,7 +202,7 @@ def thick_sivia(x0: Any, f: ThickFunction, y_lower: Any, y_upper: Any = None, *,
         max_boxes: guard on the boxes of one generation.
 
     Returns:
-        :class:`~.thick_paver.ThickPaving` (Theorem A.2: clear ⊂ X⁻, penumbra ⊂ X⁺ \\ X⁻, dark ∩ X⁺ = ∅).
+        :class:`~.paver.ThickPaving` (Theorem A.2: clear ⊂ X⁻, penumbra ⊂ X⁺ \\ X⁻, dark ∩ X⁺ = ∅).
     """
     return thick_pave(x0, ThickInverse(f, y_lower, y_upper, penumbra=penumbra), eps, max_boxes)
 

@@ -7,32 +7,15 @@ derivative contractor and the velocity models: unicycle, body-frame velocity ``x
 May import: :mod:`digslam.observer.core`; numpy.
 """
 
-from .ctc import (
-    body_velocity,
-    cumsum_enclosure,
-    deriv_arrays,
-    increments,
-    maxplus_lower,
-    unicycle_velocity,
-)
-from .tube import (
-    Tube,
-    ctc_deriv,
-    dead_reckoning,
-    heading_from_compass,
-    heading_from_gyro,
-)
+from .ctc import body_velocity, unicycle_velocity
+from .tube import Tube, ctc_deriv, dead_reckoning, heading_from_compass, heading_from_gyro
 
 __all__ = [
-    "Tube",
     "body_velocity",
     "ctc_deriv",
-    "cumsum_enclosure",
     "dead_reckoning",
-    "deriv_arrays",
     "heading_from_compass",
     "heading_from_gyro",
-    "increments",
-    "maxplus_lower",
     "unicycle_velocity",
+    "Tube",
 ]

@@ -179,7 +179,7 @@ def deriv_arrays(
     if increment is not None:
         d_lo, d_hi = np.maximum(d_lo, increment[0]), np.minimum(d_hi, increment[1])
         if (d_lo > d_hi).any():  # the increment contradicts the velocity: slice k, so gate k + 1
-            return glo, ghi, slo, shi, _first(d_lo, d_hi) + 1  # type: ignore[operator]
+            return glo, ghi, slo, shi, _first(d_lo, d_hi) + 1  # type: ignore[operator]  # not None: a row is empty
     glo, ghi = glo.copy(), ghi.copy()  # gates inside both adjacent slices (slices are closed envelopes)
     glo[:-1], ghi[:-1] = np.maximum(glo[:-1], slo), np.minimum(ghi[:-1], shi)
     glo[1:], ghi[1:] = np.maximum(glo[1:], slo), np.minimum(ghi[1:], shi)
@@ -242,7 +242,7 @@ def body_velocity(v_lo: object, v_hi: object, heading_lo: object, heading_hi: ob
     ``(v_1 cos ψ - v_2 sin ψ, v_1 sin ψ + v_2 cos ψ)``, outward rounded. A row with ``[v_2] = [0, 0]`` (a
     unicycle, which cannot slip sideways) is :func:`unicycle_velocity` to the bit: ``- [0, 0]·sin ψ`` is
     exactly zero, and dropping it keeps the signs of zero bounds (``x - (-0.0)`` turns a ``-0.0`` into
-    ``+0.0``), so a unicycle record gives the same tube as before the lateral velocity existed.
+    ``+0.0``), so a unicycle record gives the unicycle's tube to the bit.
 
     Args:
         v_lo, v_hi: ``(T, 2)`` body-frame velocity over each slice.

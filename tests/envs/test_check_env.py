@@ -1,8 +1,9 @@
 """Every registered environment keeps the Gymnasium contract, wrapped (``gym.make``) and unwrapped.
 
 The certified-coverage environments wrap the raw exploration env; its own ``step`` must return a real
-observation (the observer's skipping of it is an internal fast path), and its spec and render modes are its
-own (not the DigCoverage id's), so ``check_env(env.unwrapped)`` passes too, render checks included.
+observation (the observer skips it through the raw env's public ``step_record``). As for any env an entry
+point builds, ``gym.make`` writes the id's spec onto ``env.unwrapped``, and ``check_env(env.unwrapped)``
+passes too, render checks included (each render mode of the raw env made from that spec).
 """
 
 from __future__ import annotations
@@ -49,9 +50,10 @@ def test_check_env_wrapped_and_unwrapped(env_id: str, monkeypatch: pytest.Monkey
 
 @pytest.mark.parametrize("env_id", IDS)
 def test_spec_and_metadata_say_what_each_layer_is(env_id: str) -> None:
-    """``env.spec`` is the id's; a DigCoverage env's ``env.unwrapped`` is the raw exploration env, with a
-    spec of its own (``digslam/Explore-v0`` and its config: ``spec.make()`` builds an equal raw env, with
-    no wrappers) and the render modes of the raw env; the DigCoverage env itself renders ``rgb_array``."""
+    """``env.spec`` is the id's; a DigCoverage env's ``env.unwrapped`` is the raw exploration env, with the
+    id's spec (written there by ``gym.make``, as Gymnasium does for any entry point: ``spec.make()`` builds
+    an equal env) and the render modes of the raw env; the DigCoverage env itself renders ``rgb_array``
+    and ``human``."""
     env = _make(env_id)
     raw = env.unwrapped
     try:
@@ -61,12 +63,12 @@ def test_spec_and_metadata_say_what_each_layer_is(env_id: str) -> None:
         if env_id in digslam.envs.ENV_IDS:
             assert raw.spec.id == env_id
             return
-        assert raw.spec.id == "digslam/Explore-v0" and env.spec.additional_wrappers == ()
-        assert env.metadata["render_modes"] == ["rgb_array"]
+        assert raw.spec.id == env_id and env.spec.additional_wrappers == ()
+        assert env.metadata["render_modes"] == ["rgb_array", "human"]
         again = raw.spec.make()
         try:
-            assert type(again) is digslam.envs.ExploreEnv and again.config == raw.config
-            assert again.spec is not None and again.spec.id == "digslam/Explore-v0"
+            assert type(again.unwrapped) is digslam.envs.ExploreEnv and again.unwrapped.config == raw.config
+            assert again.spec is not None and again.spec.id == env_id
         finally:
             again.close()
     finally:

@@ -228,6 +228,7 @@ def test_frontier_proves_more_than_random_and_keeps_the_tube_narrow(dynamics: st
         "baselines.planning",
         "baselines.policy",
         "baselines.frontier",
+        "baselines.lawnmower",
         "baselines.registry",
         "baselines.tour",
         "baselines.tour_jit",

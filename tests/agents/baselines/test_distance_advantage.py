@@ -10,6 +10,7 @@ from gymnasium import spaces
 import digslam.envs  # noqa: F401  (registers the ids)
 from digslam.agents.baselines import DistanceAdvantageAgent, FrontierAgent, isolation, make_baseline
 from digslam.envs.dig_coverage.env import DigCoverageEnv
+from digslam.envs.observation import N_STATE, Channel, State
 from digslam.envs.sim.world import World
 
 M = 36
@@ -27,9 +28,10 @@ def _corridor() -> dict[str, np.ndarray]:
     pen[8:14, 28:31] = pen[23:29, 28:31] = False
     dark = ~(clear | pen)
     img = np.zeros((4, M, M), np.uint8)
-    img[0][clear], img[1][pen], img[2][dark] = 255, 255, 255
-    state = np.zeros(11, np.float32)
-    state[[4, 10]] = 1.0  # heading +x, consistent; the pose box at the centre, zero width
+    img[Channel.CLEAR][clear], img[Channel.PENUMBRA][pen], img[Channel.DARK][dark] = 255, 255, 255
+    state = np.zeros(N_STATE, np.float32)
+    # heading +x, consistent; the pose box at the centre, zero width
+    state[[State.COS, State.CONSISTENT]] = 1.0
     return {"map": img, "state": state}
 
 

@@ -9,8 +9,10 @@ from gymnasium import spaces
 from planner_obs import planner_obs
 
 import digslam.envs  # noqa: F401  (registers the env ids)
-from digslam.agents.baselines.frontier import BACK_STEPS, STALL_STEPS, FrontierAgent
+from digslam.agents.baselines.frontier import FrontierAgent
+from digslam.agents.baselines.navigating import BACK_STEPS, STALL_STEPS
 from digslam.agents.baselines.registry import BASELINES, UncertaintyAwareFrontier, make_baseline
+from digslam.envs.observation import State
 from digslam.envs.sim.generators import GENERATORS
 
 BOX = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
@@ -131,7 +133,7 @@ def test_a_robot_driving_without_moving_blocks_the_pixel_ahead_and_backs_off() -
     dark[:, 33:] = True
     obs = planner_obs(
         clear, (18.5, 10.5), dark, tube=0.05
-    )  # heading +x (state[4] = cos = 1), frontier to the east
+    )  # heading +x (State.COS = 1), frontier to the east
     for unstick in (True, False):
         agent = FrontierAgent(BOX, span=36.0, visit_radius=0.5, unstick=unstick)
         actions = [agent.predict(obs)[0] for _ in range(STALL_STEPS + 1 + BACK_STEPS)]
@@ -162,7 +164,8 @@ def test_of_two_frontiers_the_one_facing_more_dark_ground_wins() -> None:
     dark[:, :10] = True  # the large unexplored west
     dark[:, 26:28] = True  # a thin dark band to the east
     obs = planner_obs(clear, (18.0, 18.0), dark, tube=0.05)
-    obs["state"][4], obs["state"][5] = 0.0, 1.0  # heading north: both ends are a quarter turn away
+    # heading north: both ends are a quarter turn away
+    obs["state"][State.COS], obs["state"][State.SIN] = 0.0, 1.0
     goal = {}
     for w in (0.0, 40.0):
         agent = FrontierAgent(

@@ -14,6 +14,7 @@ from PIL import Image  # noqa: E402
 from digslam.agents.cli import main as cli
 from digslam.agents.evaluation import frames, pictures  # noqa: E402
 from digslam.agents.evaluation.evaluate import EvalResult, coverage_figure  # noqa: E402
+from digslam.envs.stack import observer_of  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -55,7 +56,7 @@ def first_frame():  # type: ignore[no-untyped-def]
 
     env = make_env("digslam/DigCoverage-v0", 10, {"map_size": 36})
     _, info = env.reset(seed=0)
-    drawer = pictures.FrameDrawer(pictures._observer_layer(env), "t", info.get("target"), 10)
+    drawer = pictures.FrameDrawer(observer_of(env), "t", info.get("target"), 10)
     img = drawer.frame(info, 0)
     img.putpalette(frames.flat_palette())  # as write_gif does
     rgb = np.asarray(img.convert("RGB"))

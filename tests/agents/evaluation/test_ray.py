@@ -31,16 +31,10 @@ needs_tune = pytest.mark.skipif(not _has_tune(), reason="ray[tune] is not instal
 
 from digslam.agents.cli.distributed import add_ray_options as add_eval_cli  # noqa: E402
 from digslam.agents.cli.distributed import add_sweep_parser as add_sweep_cli  # noqa: E402
+from digslam.agents.evaluation.batches import merge_results, plan_batches, split_batches  # noqa: E402
 from digslam.agents.evaluation.evaluate import evaluate  # noqa: E402
-from digslam.agents.evaluation.ray_eval import (  # noqa: E402
-    build_policy,
-    evaluate_ray,
-    merge_results,
-    normalize_specs,
-    plan_batches,
-    run_suite_ray,
-    split_batches,
-)
+from digslam.agents.evaluation.ray_eval import evaluate_ray, run_suite_ray  # noqa: E402
+from digslam.agents.evaluation.specs import build_policy, normalize_specs  # noqa: E402
 from digslam.agents.evaluation.suite import run_suite  # noqa: E402
 from digslam.agents.learning.sweep import SweepConfig, run_sweep  # noqa: E402
 

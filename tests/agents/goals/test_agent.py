@@ -118,7 +118,8 @@ def goal_model(G: ModuleType, tmp_path_factory: pytest.TempPathFactory) -> Path:
     from sb3_contrib import MaskablePPO
     from stable_baselines3.common.vec_env import DummyVecEnv
 
-    from digslam.agents.learning.train import TrainConfig, write_sidecar
+    from digslam.agents.learning.checkpoints import write_sidecar
+    from digslam.agents.learning.train_config import TrainConfig
 
     vec = DummyVecEnv([lambda: gym.make("digslam/DigCoverageGoals-v0", **GOAL_KW)])
     model = MaskablePPO("MultiInputPolicy", vec, n_steps=16, batch_size=16, n_epochs=1, seed=0, device="cpu")

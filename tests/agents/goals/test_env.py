@@ -23,6 +23,7 @@ from gymnasium import spaces
 from gymnasium.utils.env_checker import check_env
 
 from digslam.agents.baselines.policy import parse
+from digslam.envs.stack import find_wrapper
 
 SIZES = ("span", "max_speed", "max_yaw_rate", "dt", "sensor_range")
 
@@ -34,7 +35,7 @@ def G() -> ModuleType:
 
 def _make(G: ModuleType, env_id: str = "digslam/DigCoverageGoals-v0", **kw: Any) -> Any:
     env = gym.make(env_id, **{"map_size": 36, "max_steps": 300, **kw})
-    assert isinstance(env.unwrapped, G.GoalSelectionEnv)
+    assert isinstance(find_wrapper(env, G.GoalSelectionEnv), G.GoalSelectionEnv)
     return env
 
 
@@ -93,7 +94,7 @@ def test_one_id_per_suite_generator_registered_on_import_only(G: ModuleType) -> 
     worlds = {kw.get("world", "room") for kw in G.GOAL_IDS.values()}
     assert worlds == set(GENERATORS) and {GENERATORS[w][0] for w in worlds} == {"digslam/DigCoverage-v0"}
     env = gym.make("digslam.agents.goals:digslam/DigCoverageGoalsRocks-v0", map_size=36)
-    assert env.unwrapped.env.unwrapped.config.world == "rocks"
+    assert env.unwrapped.config.world == "rocks"
     assert env.unwrapped.spec.id == "digslam/DigCoverageGoalsRocks-v0"
     code = "import gymnasium as gym, digslam.envs; print(any('Goals' in i for i in gym.registry))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
@@ -101,10 +102,11 @@ def test_one_id_per_suite_generator_registered_on_import_only(G: ModuleType) -> 
 
 
 def test_check_env_on_the_registered_env(G: ModuleType) -> None:
-    env = _make(G).unwrapped  # gym.make's checker wrappers off: the goal env itself, with its spec
+    env = find_wrapper(_make(G), G.GoalSelectionEnv)  # gym.make's checker wrappers off: the goal env itself
     env.action_space = _FirstSample(env.n)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
+        warnings.filterwarnings("ignore", message=".*different from the unwrapped version")  # a wrapper
         check_env(env)  # renders too: the spec rebuilds the env with render_mode="rgb_array"
     assert env.observation_space["candidates"].shape == (16, G.N_FEATURES)
     assert env.observation_space["global"].shape == (len(G.GLOBALS),)
@@ -135,7 +137,7 @@ def test_a_random_masked_policy_keeps_to_valid_reachable_goals(G: ModuleType) ->
     for seed in (11, 12, 13):
         env = _make(G, "digslam/DigCoverageGoalsRocks-v0" if seed == 12 else "digslam/DigCoverageGoals-v0",
                     max_steps=400)  # fmt: skip
-        raw, pol = env.unwrapped, G.RandomCandidatePolicy(seed=seed)
+        raw, pol = find_wrapper(env, G.GoalSelectionEnv), G.RandomCandidatePolicy(seed=seed)
         obs, _ = env.reset(seed=seed)
         done, elapsed = False, 0
         while not done:
@@ -168,7 +170,7 @@ def test_a_random_masked_policy_keeps_to_valid_reachable_goals(G: ModuleType) ->
 
 
 def test_a_masked_or_malformed_action_raises_value_error(G: ModuleType) -> None:
-    env = _make(G).unwrapped
+    env = find_wrapper(_make(G), G.GoalSelectionEnv)
     with pytest.raises(RuntimeError, match="reset"):
         env.step(0)
     env.reset(seed=3)
@@ -242,8 +244,9 @@ def test_maskable_ppo_learns_on_it(G: ModuleType) -> None:
     model = sb3c.MaskablePPO("MultiInputPolicy", env, n_steps=16, batch_size=8, n_epochs=1, seed=0)
     model.learn(16)
     obs, _ = env.reset(seed=1)
-    action, _ = model.predict(obs, action_masks=env.unwrapped.action_masks(), deterministic=True)
-    assert env.unwrapped.action_masks()[int(action)]
+    goal = find_wrapper(env, G.GoalSelectionEnv)
+    action, _ = model.predict(obs, action_masks=goal.action_masks(), deterministic=True)
+    assert goal.action_masks()[int(action)]
 
 
 def test_module_doctests(G: ModuleType) -> None:

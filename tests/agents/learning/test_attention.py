@@ -75,13 +75,14 @@ def test_untrained_policy_picks_the_heuristics_first_and_round_trips(tmp_path) -
     import gymnasium as gym
     from sb3_contrib import MaskablePPO
 
-    import digslam.agents.goals  # noqa: F401
+    import digslam.agents.goals
+    from digslam.envs.stack import find_wrapper
 
     env = gym.make("digslam/DigCoverageGoals-v0", max_steps=120, step_cap=20)
     model = MaskablePPO(CandidateAttentionPolicy, env, n_steps=16, batch_size=8, n_epochs=1, seed=0,
                         device="cpu", policy_kwargs={"d": 16, "heads": 4, "heuristic_prior": 5.0})  # fmt: skip
     obs, _ = env.reset(seed=1_000_000)
-    mask = env.unwrapped.action_masks()
+    mask = find_wrapper(env, digslam.agents.goals.GoalSelectionEnv).action_masks()
     assert int(model.predict(obs, action_masks=mask, deterministic=True)[0]) == 0
     model.learn(16)
     model.save(tmp_path / "m.zip")

@@ -17,7 +17,9 @@ from gymnasium import spaces  # noqa: E402
 
 from digslam.agents.learning.extractor import MapStateExtractor, conv_plan  # noqa: E402
 from digslam.agents.learning.models import TRAINING_ONLY, model_env_kwargs  # noqa: E402
-from digslam.agents.learning.train import DEFAULT_CONFIG, EnvFactory, TrainConfig, parse_value  # noqa: E402
+from digslam.agents.learning.train_config import DEFAULT_CONFIG, TrainConfig  # noqa: E402
+from digslam.agents.learning.vec_env import EnvFactory  # noqa: E402
+from digslam.observer.core.config import parse_value  # noqa: E402
 
 
 def _space(c: int, m: int) -> spaces.Dict:
@@ -125,7 +127,8 @@ def test_env_factory_is_picklable_and_cycles_held_out_seeds() -> None:
 
 
 def test_ppo_with_the_extractor_predicts_on_the_env() -> None:
-    from digslam.agents.learning.train import build_model, make_vec_env
+    from digslam.agents.learning.algos import build_model
+    from digslam.agents.learning.vec_env import make_vec_env
 
     cfg = TrainConfig(n_envs=1, n_steps=16, batch_size=16, features_dim=16)
     vec = make_vec_env(EnvFactory(cfg.env_id, cfg.env_kwargs, 1), 1, 0)
@@ -208,8 +211,9 @@ def test_turn_go_actions_and_tube_penalty() -> None:
 
 def test_turn_go_model_acts_in_the_continuous_env(tmp_path) -> None:  # type: ignore[no-untyped-def]
     """A model trained on turn-or-go actions loads as a continuous-action policy (``TurnGoPolicy``)."""
+    from digslam.agents.learning.algos import build_model
     from digslam.agents.learning.models import load_ppo
-    from digslam.agents.learning.train import EnvFactory, build_model, make_vec_env
+    from digslam.agents.learning.vec_env import EnvFactory, make_vec_env
     from digslam.agents.learning.wrappers import TURN_GO, TurnGoPolicy
 
     cfg = TrainConfig(n_envs=1, n_steps=32, batch_size=32, features_dim=16, actions="turn_go",
@@ -233,7 +237,9 @@ def test_maskable_ppo_trains_on_the_goal_env_from_the_heuristic_prior(tmp_path) 
     start from the heuristic's ranking (candidate 0 first), and its model comes with its sidecar."""
     import torch
 
-    from digslam.agents.learning.train import build_maskable, env_module, make_vec_env, train
+    from digslam.agents.learning.algos import build_maskable
+    from digslam.agents.learning.train import train
+    from digslam.agents.learning.vec_env import env_module, make_vec_env
 
     assert env_module("digslam/DigCoverageGoalsRooms-v0") == "digslam.agents.goals"
     cfg = TrainConfig.from_file(
@@ -260,7 +266,8 @@ def test_train_resumes_from_the_latest_checkpoint(tmp_path) -> None:  # type: ig
     checkpoint or ``interrupted_model.zip``) up to ``total_timesteps``; without one it starts afresh."""
     from stable_baselines3 import PPO
 
-    from digslam.agents.learning.train import latest_checkpoint, train
+    from digslam.agents.learning.checkpoints import latest_checkpoint
+    from digslam.agents.learning.train import train
 
     base = ["n_envs=1", "n_steps=32", "batch_size=32", "n_epochs=1", "features_dim=16", "eval_freq=0",
             "checkpoint_freq=32", "progress_bar=false", "env_kwargs.max_episode_steps=40",
@@ -275,3 +282,21 @@ def test_train_resumes_from_the_latest_checkpoint(tmp_path) -> None:  # type: ig
     final = train(TrainConfig.from_file(None, [*base, "total_timesteps=128", "resume=true"]))
     assert PPO.load(final, device="cpu").num_timesteps == 128  # 64 more, not 128 more
     assert latest_checkpoint(tmp_path)[1] == 128
+
+
+@pytest.mark.parametrize("name", ["PRETRAINED", "CHOOSER", "LOWLEVEL"])
+def test_every_shipped_model_loads_and_acts(name: str) -> None:
+    """A saved model names its classes by module path (the extractor, the attention policy): every shipped
+    model loads at today's paths and acts in the env of its sidecar."""
+    import digslam.envs  # noqa: F401  (registers the ids)
+    from digslam.agents.learning import models
+
+    path = getattr(models, name)
+    env = gym.make(models.DEFAULT_ENV, **models.model_env_kwargs(path))
+    try:
+        policy = models.load_ppo(path, env)
+        obs, _ = env.reset(seed=0)
+        action, _ = policy.predict(obs, deterministic=True)
+        assert env.action_space.contains(np.asarray(action, np.float32).reshape(env.action_space.shape))
+    finally:
+        env.close()

@@ -14,7 +14,8 @@ torch = pytest.importorskip("torch")
 import gymnasium as gym  # noqa: E402
 
 import digslam.agents.goals  # noqa: E402, F401
-from digslam.agents.learning.train import TrainConfig, train  # noqa: E402
+from digslam.agents.learning.train import train  # noqa: E402
+from digslam.agents.learning.train_config import TrainConfig  # noqa: E402
 from digslam.agents.learning.warm_start import DEMO_SEED, clone, collect, level_seeds  # noqa: E402
 
 

@@ -131,7 +131,8 @@ def test_the_chooser_config_trains_loads_and_evaluates_at_tiny_size(tmp_path):
 
     from digslam.agents.evaluation.suite import run_suite
     from digslam.agents.learning import models
-    from digslam.agents.learning.train import TrainConfig, train
+    from digslam.agents.learning.train import train
+    from digslam.agents.learning.train_config import TrainConfig
 
     cfg = TrainConfig.from_file(
         Path(__file__).parents[3] / "agents" / "configs" / "goals_predictive.toml",

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from digslam.envs.dig_coverage.env import DigCoverageEnv
-from digslam.envs.dig_coverage.maps_jit import MapPlanes, map_context, observe
+from digslam.envs.dig_coverage.maps_jit import MapPlanes
+from digslam.envs.dig_coverage.observe_jit import map_context, observe
 from digslam.envs.sim.world import World
 from digslam.observer.record.grid import Grid
 

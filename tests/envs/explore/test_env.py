@@ -343,3 +343,24 @@ def test_example_script_writes_a_png(tmp_path: Path) -> None:
         capture_output=True,
     )
     assert (tmp_path / "Explore-v0.png").stat().st_size > 1000
+
+
+def test_step_record_is_the_step_without_its_observation() -> None:
+    """The wrappers' fast path: the same reward, ends, record and truth as ``step``, the env moved alike."""
+    a, b = ExploreEnv(), ExploreEnv()
+    a.reset(seed=2)
+    b.reset(seed=2)
+    for act in _actions(12, 1):
+        _, reward, terminated, truncated, info = a.step(act)
+        *ends, fast = b.step_record(act)
+        assert tuple(ends) == (reward, terminated, truncated) and fast.keys() == info.keys()
+        assert info["record"].same_as(fast["record"]) and info["truth"] == fast["truth"]
+
+
+def test_without_coverage_the_raw_env_measures_no_ground_truth() -> None:
+    env = ExploreEnv(measure_coverage=False)
+    obs, info = env.reset(seed=1)
+    assert env.coverage is None and "coverage" not in info and env.observation_space.contains(obs)
+    obs, reward, terminated, _, info = env.step(np.array([1.0, 0.3], np.float32))
+    assert (reward, terminated) == (0.0, False) and "coverage" not in info and "record" in info
+    assert env.observation_space.contains(obs)

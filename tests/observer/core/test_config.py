@@ -9,6 +9,7 @@ import pytest
 
 from digslam.observer.core.config import (
     Config,
+    apply_overrides,
     check,
     check_choice,
     check_finite_nonneg,
@@ -18,6 +19,8 @@ from digslam.observer.core.config import (
     config_dataclass,
     is_int,
     is_number,
+    parse_value,
+    read_config_file,
 )
 
 
@@ -115,3 +118,51 @@ def test_checkers():
         check_choice("m", "c", ["a", "b"])
     assert is_int(np.int32(1)) and not is_int(True) and not is_int(1.0)
     assert is_number(np.float32(1)) and is_number(2) and not is_number(np.bool_(True)) and not is_number("1")
+
+
+@config_dataclass
+class Run(Config):
+    steps: int = 1
+    name: str = "run"
+    options: dict = dataclasses.field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        check_int("steps", self.steps, 1)
+
+
+def test_config_files_are_read_by_one_reader_with_one_line_errors(tmp_path):
+    t = tmp_path / "c.toml"
+    t.write_text("steps = 3\n[options]\nsize = 40\n")
+    j = tmp_path / "c.json"
+    j.write_text('{"steps": 4, "options": {"crop": 4.0}}')
+    assert read_config_file(t) == {"steps": 3, "options": {"size": 40}}
+    assert Run.from_file(j) == Run(steps=4, options={"crop": 4.0})
+    assert Run.from_file(t, ["name=other", "options.crop=2.5"]) == Run(3, "other", {"size": 40, "crop": 2.5})
+    bad = tmp_path / "bad.toml"
+    bad.write_text("steps = = 3\n")
+    lst = tmp_path / "list.json"
+    lst.write_text("[1, 2]")
+    for path, words in ((tmp_path / "missing.toml", "no configuration file"), (tmp_path / "c.yaml", "must be"),
+                        (bad, "cannot read"), (lst, "table of settings")):  # fmt: skip
+        if path.suffix == ".yaml":
+            path.write_text("steps: 1")
+        with pytest.raises(ValueError, match=f"^path: .*{words}") as exc:
+            read_config_file(path)
+        assert "\n" not in str(exc.value)
+    with pytest.raises(ValueError, match=r"Run: unknown key\(s\) \['stpes'\]"):
+        Run.from_dict(read_config_file(t) | {"stpes": 1})
+
+
+def test_overrides_are_toml_literals_and_name_the_key():
+    assert parse_value("1e-4") == 1e-4 and parse_value("true") is True and parse_value("plain") == "plain"
+    assert parse_value("{a = 1}") == {"a": 1} and parse_value('"quoted"') == "quoted"
+    assert apply_overrides({"a": 1, "t": {"x": 1}}, ["a=2", "t.y=3"], dotted=("t",)) == {
+        "a": 2,
+        "t": {"x": 1, "y": 3},
+    }
+    for item, key in (("b=1", "b"), ("a.x=1", "a.x"), ("noequals", "overrides")):
+        with pytest.raises(ValueError, match=key.replace(".", r"\.")):
+            apply_overrides({"a": 1}, [item])
+    assert Run().override([]) == Run() and Run().override(["steps=5"]).steps == 5
+    with pytest.raises(ValueError, match="steps: must be an integer >= 1"):
+        Run().override(["steps=0"])

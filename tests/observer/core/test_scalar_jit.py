@@ -48,6 +48,9 @@ def test_interval_kernels_contain_point_images(
     )
     lo, hi = jit.imul(al, ah, bl, bh)
     assert Fraction(lo) <= x * y <= Fraction(hi)
+    one_lo, one_hi = jit.imul_lo(al, ah, bl, bh), jit.imul_hi(al, ah, bl, bh)  # one rounding step
+    assert Fraction(one_lo) <= x * y <= Fraction(one_hi)
+    assert one_lo <= lo and hi <= one_hi
     lo, hi = jit.isqr(al, ah)
     assert 0 <= hi and Fraction(lo) <= x * x <= Fraction(hi)
     lo, hi = jit.idiv(al, ah, bl, bh)

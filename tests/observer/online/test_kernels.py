@@ -1,7 +1,7 @@
-"""Compiled kernels of the online filter against the previous numpy kernels (kept here as oracles) and the truth.
+"""Compiled kernels of the online filter against numpy oracles and the truth.
 
-The oracles are the numpy implementations that the compiled kernels replaced (round-to-nearest tests
-against the relative margin ``MARGIN``). The compiled kernels prove every claim with outward rounding, so
+The oracles are numpy implementations of the same tests in round-to-nearest, against the relative margin
+``MARGIN``. The compiled kernels prove every claim with outward rounding, so
 they may differ from the oracles only at cell borders (a few cells): the dug cells are those of the rigorous
 offline :class:`DigMap`; the compiled possibly-sensed zone can be a few cells tighter than the oracle's (it
 also uses the sector's bounding box). Soundness is checked by sampling against exact geometry and by the
@@ -26,19 +26,21 @@ from digslam.envs.sim.generators import ThesisRoom
 from digslam.envs.sim.missions import loop_mission
 from digslam.envs.sim.sensors import SensorSuite
 from digslam.observer.core import rounding as rnd
-from digslam.observer.online.dig_jit import PoseBox, StepRecord
+from digslam.observer.online.dig_types import PoseBox, StepRecord
 from digslam.observer.online.observer import OnlineDigSlam
 from digslam.observer.online.pose_jit import TRIG_PAD, cos_sin, predict, rotate
-from digslam.observer.online.window import MARGIN, WindowDigMap, mark_possibly_sensed
+from digslam.observer.online.window import WindowDigMap, mark_possibly_sensed
 from digslam.observer.record.grid import Grid
 from digslam.observer.slam.digmap import EDT_SLACK, DigMap
 from digslam.observer.thick.cells import CLEAR, DARK, PENUMBRA
 
 G = Grid((-6.0, -6.0), (6.0, 6.0), (96, 96))
 PI_40 = Fraction("3.1415926535897932384626433832795028841971")  # π to 40 digits
+#: Relative margin of the oracles' round-to-nearest pair tests.
+MARGIN = 1e-13
 
 
-# ------------------------------------------------------------------ numpy oracles (the previous kernels)
+# ------------------------------------------------------------------ numpy oracles
 def oracle_dig_disk(free: np.ndarray, lo: np.ndarray, hi: np.ndarray, r: float) -> None:
     ys = G.ys
     my = np.maximum(ys[:-1] - lo[1], hi[1] - ys[1:])
@@ -440,7 +442,7 @@ def test_wrapper_sets_kept_up_to_date_equal_the_filter_sets(window: int) -> None
 
 
 def test_dig_and_mark_window_holds_every_changed_cell_and_filter_step_matches_the_kernels() -> None:
-    from digslam.observer.online.dig_jit import CellSets
+    from digslam.observer.online.dig_types import CellSets
     from digslam.observer.online.mark_jit import dig_and_mark
     from digslam.observer.online.pose_jit import contract, impact_bound
     from digslam.observer.online.step_jit import filter_step
@@ -493,14 +495,8 @@ def test_dig_and_mark_window_holds_every_changed_cell_and_filter_step_matches_th
 
 
 def test_observe_matches_its_pieces() -> None:
-    from digslam.envs.dig_coverage.maps_jit import (
-        MapPlanes,
-        map_context,
-        observe,
-        pixel_blocks,
-        pixel_range,
-        sets_and_map,
-    )
+    from digslam.envs.dig_coverage.maps_jit import MapPlanes, pixel_blocks, pixel_range, sets_and_map
+    from digslam.envs.dig_coverage.observe_jit import map_context, observe
     from digslam.observer.core.grid_jit import window
 
     rng = np.random.default_rng(6)
@@ -565,7 +561,7 @@ def test_rotate_without_lateral_is_the_unicycle_product() -> None:
     """``[v_2] = [0, 0]``: :func:`rotate` is the unicycle's ``[v_1]·[c]``, ``[v_1]·[s]`` to the bit (what
     keeps every unicycle step of the filter unchanged); with ``v_2`` it encloses them, signs of zero
     included, and an unbounded ``v_2`` gives unbounded bounds, never NaN."""
-    from digslam.observer.online.dig_jit import prod_hi, prod_lo
+    from digslam.observer.core.scalar_jit import imul_hi, imul_lo
 
     rng = np.random.default_rng(21)
     for _ in range(500):
@@ -573,8 +569,8 @@ def test_rotate_without_lateral_is_the_unicycle_product() -> None:
         vh = vl + float(rng.choice([0.0, rng.uniform(0, 1)]))
         pl = rng.uniform(-7, 7)
         cs = cos_sin(pl, pl + rng.uniform(0, 2))
-        uni = (prod_lo(vl, vh, cs[0], cs[1]), prod_hi(vl, vh, cs[0], cs[1]), prod_lo(vl, vh, cs[2], cs[3]),
-               prod_hi(vl, vh, cs[2], cs[3]))  # fmt: skip
+        uni = (imul_lo(vl, vh, cs[0], cs[1]), imul_hi(vl, vh, cs[0], cs[1]), imul_lo(vl, vh, cs[2], cs[3]),
+               imul_hi(vl, vh, cs[2], cs[3]))  # fmt: skip
         got = rotate(vl, vh, 0.0, 0.0, *cs)
         assert np.array(got).tobytes() == np.array(uni).tobytes()
         w = rotate(vl, vh, -0.1, 0.2, *cs)
@@ -619,7 +615,7 @@ def test_the_odometry_increment_bounds_the_step_exactly_and_tightly() -> None:
     model alone gives a displacement about 0.1 m wide; the increment ``mean_velocity`` (the displacement in
     the start frame, per second) keeps it within the heading's and the noise's widths, and the exact
     displacement (mpmath) stays inside. A contradicting increment empties the box."""
-    from digslam.observer.online.dig_jit import PoseBox
+    from digslam.observer.online.dig_types import PoseBox
 
     rng = np.random.default_rng(31)
     for _ in range(300):

@@ -13,19 +13,12 @@ from digslam.envs.sim.sensors import SensorSuite
 from digslam.observer.record.grid import Grid
 from digslam.observer.slam.digslam import DigSlamConfig
 from digslam.observer.slam.digslam import thesis_dig_slam as dig_slam
-from digslam.observer.slam.explicit_slam import (
-    ExplicitSlamConfig,
-    MapFunction,
-    RangeMeasurements,
-    RasterShape,
-    ShapeMeasurements,
-    ThickMap,
-    explicit_slam,
-    mission_tube,
-    shape_carve,
-    shape_register,
-)
+from digslam.observer.slam.explicit_slam import ExplicitSlamConfig, explicit_slam, mission_tube
+from digslam.observer.slam.measurements import RangeMeasurements, ShapeMeasurements
+from digslam.observer.slam.raster_shape import RasterShape
 from digslam.observer.slam.shape_slam import ShapeSlamConfig, shape_slam
+from digslam.observer.slam.shape_srac import shape_carve, shape_register
+from digslam.observer.slam.thick_map import MapFunction, ThickMap
 from digslam.observer.tube.tube import Tube
 
 

@@ -1,4 +1,4 @@
-"""Tests of observer.thick_interval: worked numbers of §A.3 and Example A.2."""
+"""Tests of digslam.observer.thick.interval: worked numbers of §A.3 and Example A.2."""
 
 import numpy as np
 import pytest
