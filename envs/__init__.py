@@ -53,6 +53,7 @@ ENV_IDS: dict[str, dict[str, object]] = {
     "digslam/ExploreRocks-v0": {"world": "rocks"},
     "digslam/ExploreCaves-v0": {"world": "caves"},
     "digslam/ExploreRooms-v0": {"world": "rooms"},
+    "digslam/ExploreFloorplan-v0": {"world": "floorplan"},
     "digslam/ExploreAdversarial-v0": {"noise": {"model": "adversarial"}},
     "digslam/ExploreOutliers-v0": {"world": "rocks", "noise": {"outlier_prob": 0.05, "max_outliers": 1}},
 }
@@ -63,6 +64,7 @@ COVERAGE_IDS: dict[str, dict[str, object]] = {
     "digslam/DigCoverageOmni-v0": {"n_sonars": 0},
     "digslam/DigCoverageSonar-v0": {"omni": False},
     "digslam/DigCoverageCaves-v0": {"world": "caves", "world_size": 20.0},
+    "digslam/DigCoverageFloorplan-v0": {"world": "floorplan"},
     "digslam/DigCoverageAdversarial-v0": {"noise": {"model": "adversarial"}},
     # the tube matters: odometry 10x noisier than the default, so an agent that never returns to known walls
     # loses its pose (the impacts on known walls are what narrows the pose box again)

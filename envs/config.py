@@ -9,6 +9,7 @@ Noise bounds default to the thesis's orders of magnitude (§6.4.2: 0.001 m/s, 0.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Mapping
 from dataclasses import field
 
@@ -24,7 +25,7 @@ from digslam.observer.core.config import (
 )
 
 NOISE_MODELS = ("uniform", "adversarial", "biased")
-WORLDS = ("room", "rocks", "caves", "rooms", "file", "mixed")
+WORLDS = ("room", "rocks", "caves", "rooms", "file", "mixed", "floorplan")
 #: How the robot moves (:mod:`digslam.envs.sim.robot`): pymunk rigid-body dynamics or exact unicycle arcs.
 DYNAMICS = ("pymunk", "unicycle")
 #: How a reset picks the start pose when ``start`` is None.
@@ -78,11 +79,15 @@ class ExploreConfig(Config):
     """Configuration of ``digslam/Explore-v0``.
 
     Attributes:
-        world: Generator name, one of ``room`` (thesis Fig. 6.10), ``rocks``, ``caves``, ``rooms``, ``file``,
-            or ``mixed`` (each level from one of the first four, drawn from its seed: training across them).
+        world: Generator name, one of ``room`` (thesis Fig. 6.10), ``rocks``, ``caves``, ``rooms``, ``file``
+            (one map stretched over the frame), ``mixed`` (each level from one of the first four, drawn from
+            its seed: training across them) or ``floorplan`` (windows of real floor plans at metric scale:
+            the shipped KTH plans, split by plan, or the maps of ``floorplans``).
         world_size: Half-width of the square frame (m); the frame is ``[-s, s]^2``.
         n_obstacles: Number of rocks (``world='rocks'``).
         map_path: Polygon (``.json``/``.npz``) or image file for ``world="file"``.
+        floorplans: Maps for ``world="floorplan"``: ROS map YAML files or ``.npz`` plans (None: the shipped
+            plans). With the user's maps every seed is a level and no split applies.
         fixed_world: Keep the world of the first reset until a reset passes a seed (True), or draw a new one
             at every reset (False, the default: every episode is a new level, Procgen style;
             ``reset(seed=s)`` always builds the world of level ``s``).
@@ -125,6 +130,7 @@ class ExploreConfig(Config):
     world_size: float = 10.0
     n_obstacles: int = 30
     map_path: str | None = None
+    floorplans: tuple[str, ...] | None = None
     fixed_world: bool = False
     room_jitter: float = 0.3
     map_seed: int | None = None
@@ -154,6 +160,15 @@ class ExploreConfig(Config):
         check_choice("dynamics", self.dynamics, DYNAMICS)
         check_choice("start_rule", self.start_rule, START_RULES)
         check(self.world != "file" or bool(self.map_path), "map_path", "is required when world='file'")
+        if self.floorplans is not None:
+            paths = self.floorplans
+            if isinstance(paths, (str, bytes, os.PathLike)) or not all(
+                isinstance(f, (str, os.PathLike)) and os.fspath(f) for f in paths
+            ):
+                raise ValueError(
+                    f"floorplans: must be a list of map paths (ROS map .yaml, .npz), got {paths!r}"
+                )
+            object.__setattr__(self, "floorplans", tuple(os.fspath(f) for f in paths))
         for name in (
             "world_size",
             "robot_radius",

@@ -51,6 +51,7 @@ from digslam.envs.sim.noise_jit import obs_kernel
 from digslam.envs.sim.robot import RobotSim
 from digslam.envs.sim.sensors import SensorSuite, record_step
 from digslam.envs.sim.world import World
+from digslam.envs.splits import split_of
 from digslam.observer.record.mission import MissionRecord
 
 if TYPE_CHECKING:  # pygame is imported on use only
@@ -138,7 +139,10 @@ class ExploreEnv(gym.Env):
                 self.world, self._world_seed = self.generator.generate(cfg.map_seed), cfg.map_seed
         elif seed is not None or self.world is None or not cfg.fixed_world:
             self._world_seed = int(self.np_random.integers(2**31 - 1))
-            self.world = self.generator.generate(self._world_seed)
+            # the split of the reset seed (an unseeded reset draws a training level): a generator of real
+            # maps keeps each map to one split
+            split = split_of(seed) if seed is not None else "train"
+            self.world = self.generator.generate(self._world_seed, split=split)
         skin = 1.5 * cfg.max_speed * cfg.dt / cfg.substeps
         if cfg.start is not None:
             pose = np.asarray(cfg.start, dtype=np.float64)

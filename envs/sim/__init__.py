@@ -1,11 +1,12 @@
 """The simulator: unstructured 2-D worlds, the robot that moves in them, and its bounded sensors.
 
 Lives here, in data-flow order: :mod:`.world` (``World``: polygonal obstacles and a raster), :mod:`.tracing`
-(marching squares), :mod:`.raster`, :mod:`.generators` (``ThesisRoom``, ``RockField``, ``Caves``,
-``RoomsCorridors``, ``FileMap``, ``Mixed``), :mod:`.geometry` and :mod:`.geometry_jit` (rigorous point-edge
-and sector distances), :mod:`.arc_jit` (the exact arc of one piece of motion and its proved error bound),
-:mod:`.robot` and :mod:`.robot_jit` (``RobotSim``: pymunk dynamics or exact unicycle arcs),
-:mod:`.dynamics_jit` (the pymunk robot's premise guard, substep durations and velocity bounds),
+(marching squares), :mod:`.raster`, :mod:`.occupancy` (maps at metric scale: ROS map files, floor plans,
+images with a resolution), :mod:`.generators` (the registry: ``ThesisRoom``, ``RockField``, ``Caves``,
+``RoomsCorridors``, ``FileMap``, ``Mixed``, ``Floorplan``), :mod:`.geometry` and :mod:`.geometry_jit`
+(rigorous point-edge and sector distances), :mod:`.arc_jit` (the exact arc of one piece of motion and its
+proved error bound), :mod:`.robot` and :mod:`.robot_jit` (``RobotSim``: pymunk dynamics or exact unicycle
+arcs), :mod:`.dynamics_jit` (the pymunk robot's premise guard, substep durations and velocity bounds),
 :mod:`.sensors` (``SensorSuite``: sonars, omnidirectional range, odometry, compass), :mod:`.noise` and
 :mod:`.noise_jit` (bounded noise, outliers), :mod:`.missions` (the thesis's missions as records) and
 :mod:`.render` (pictures).
@@ -20,6 +21,7 @@ from .generators import (
     THESIS_ROOM,
     Caves,
     FileMap,
+    Floorplan,
     Generator,
     Mixed,
     RockField,
@@ -29,6 +31,7 @@ from .generators import (
     make_generator,
 )
 from .missions import THESIS_LOOP, loop_mission
+from .occupancy import OccupancyMap, load_map
 from .robot import RobotSim
 from .sensors import SensorSuite
 from .world import World
@@ -37,6 +40,7 @@ __all__ = [
     "BENCHMARK",
     "Caves",
     "FileMap",
+    "Floorplan",
     "GENERATORS",
     "Generator",
     "Mixed",
@@ -47,8 +51,10 @@ __all__ = [
     "THESIS_LOOP",
     "THESIS_ROOM",
     "ThesisRoom",
+    "OccupancyMap",
     "World",
     "WorldGenerator",
+    "load_map",
     "loop_mission",
     "make_generator",
 ]

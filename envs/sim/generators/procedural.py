@@ -1,24 +1,16 @@
-"""Seeded world generators, and the one registry that names them (:data:`GENERATORS`).
+"""The procedural generators: the thesis room (Fig. 6.10), a rock field, caves and rooms off corridors.
 
-A generator is anything with a ``frame`` and a ``generate(seed)`` that builds a world from a seed
-(:class:`Generator`). Those of the registry subclass :class:`WorldGenerator` and override one hook,
-``_gen_world``; each builds itself from an env config (:meth:`WorldGenerator.from_config`), and
-:func:`make_generator` builds the one a config names (``config.world``). They build worlds in the frame
-``[-size, size]^2`` and keep a clear disc of radius ``keep_clear`` around the origin so that the default
-start pose ``(0, 0)`` is free.
-
->>> sorted(GENERATORS), BENCHMARK
-(['caves', 'file', 'mixed', 'rocks', 'room', 'rooms'], ('room', 'rocks', 'caves', 'rooms'))
+Each keeps a clear disc of radius ``keep_clear`` around the origin so that the default start pose ``(0, 0)``
+is free; the same seed gives the same world.
 """
 
 from __future__ import annotations
 
-import json
-from pathlib import Path
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+from digslam.envs.sim.generators.base import WorldGenerator
 from digslam.envs.sim.tracing import marching_squares, mask_edges, smooth_noise
 from digslam.envs.sim.world import World
 
@@ -45,56 +37,6 @@ THESIS_ROOM = np.array(
         (-9.3, -3.0),
     ]
 )
-
-
-class Generator(Protocol):
-    """What an env needs of a world generator: the frame its worlds lie in, and one world per seed (the same
-    seed, the same world)."""
-
-    @property
-    def frame(self) -> tuple[float, float, float, float]: ...
-
-    def generate(self, seed: int | None = None) -> World: ...
-
-
-class WorldGenerator:
-    """Base class: ``generate(seed)`` calls the ``_gen_world(rng)`` hook of the subclass.
-
-    Args:
-        size: Half-width of the square frame (m).
-        keep_clear: Radius of the obstacle-free disc around the origin (m).
-    """
-
-    name = "world"
-
-    def __init__(self, size: float = 10.0, keep_clear: float = 1.0) -> None:
-        if not size > 0:
-            raise ValueError(f"size: must be > 0, got {size!r}")
-        self.size = float(size)
-        self.keep_clear = float(keep_clear)
-
-    @property
-    def frame(self) -> tuple[float, float, float, float]:
-        """``(-size, -size, size, size)``."""
-        s = self.size
-        return (-s, -s, s, s)
-
-    @classmethod
-    def from_config(cls, cfg: ExploreConfig) -> WorldGenerator:
-        """The generator with the settings of ``cfg`` (:class:`~digslam.envs.config.ExploreConfig`):
-        ``world_size``, and the fields of the subclass's own world."""
-        return cls(size=cfg.world_size)
-
-    def generate(self, seed: int | None = None) -> World:
-        """Build a world from ``seed`` (same seed, same world)."""
-        return self._gen_world(np.random.default_rng(seed))
-
-    def _gen_world(self, rng: np.random.Generator) -> World:
-        raise NotImplementedError
-
-    def _frame_ring(self) -> np.ndarray:
-        x0, y0, x1, y1 = self.frame
-        return np.array([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
 
 
 class ThesisRoom(WorldGenerator):
@@ -265,112 +207,4 @@ class RoomsCorridors(WorldGenerator):
         return World.from_edges(self.frame, mask_edges(free, self.frame), self.name)
 
 
-class FileMap(WorldGenerator):
-    """A map from a file: JSON ``{"frame": [x0, y0, x1, y1], "rings": [[[x, y], ...], ...]}`` (free where the
-    crossing count is odd), or a binary image (``.npy`` bool array, or ``.png``/``.bmp`` where bright is free)
-    stretched over ``[-size, size]^2``."""
-
-    name = "file"
-
-    def __init__(self, path: str | Path, size: float = 10.0, **kw: float) -> None:
-        super().__init__(size, **kw)
-        self.path = Path(path)
-        if not self.path.exists():
-            raise ValueError(f"map_path: file {str(self.path)!r} does not exist")
-
-    @classmethod
-    def from_config(cls, cfg: ExploreConfig) -> WorldGenerator:
-        """The map of ``map_path`` stretched over the frame of ``world_size``."""
-        if cfg.map_path is None:
-            raise ValueError("map_path: is required when world='file'")
-        return cls(cfg.map_path, size=cfg.world_size)
-
-    def _gen_world(self, rng: np.random.Generator) -> World:
-        suffix = self.path.suffix.lower()
-        if suffix == ".json":
-            data = json.loads(self.path.read_text())
-            for key in ("frame", "rings"):
-                if key not in data:
-                    raise ValueError(f"map_path: {self.path.name} lacks the key {key!r}")
-            return World(tuple(data["frame"]), [np.asarray(r, float) for r in data["rings"]], self.path.stem)
-        if suffix == ".npy":
-            img = np.load(self.path).astype(bool)
-        else:
-            import pygame  # only for image maps
-
-            arr = pygame.surfarray.array3d(pygame.image.load(str(self.path))).astype(float)  # (w, h, 3)
-            img = arr.mean(axis=2).T > 127.5
-        if img.ndim != 2:
-            raise ValueError(f"map_path: image must be 2-D, got shape {img.shape}")
-        free = img[::-1].copy()  # image row 0 is the top
-        free[[0, -1], :] = free[:, [0, -1]] = False
-        return World.from_edges(self.frame, mask_edges(free, self.frame), self.path.stem)
-
-
-class Mixed(WorldGenerator):
-    """Each level from one of ``generators`` (those of :data:`BENCHMARK` by default: room, rocks, caves,
-    rooms), drawn from the level's seed (uniformly), then built by that generator from the same random
-    stream: one env id over every generator of the coverage suite, for training across them. The same seed
-    gives the same world.
-
-    Args:
-        generators: The generators to draw from (built by the caller with their own settings).
-    """
-
-    name = "mixed"
-
-    def __init__(self, generators: tuple[WorldGenerator, ...] = (), size: float = 10.0, **kw: float) -> None:
-        super().__init__(size, **kw)
-        self.generators = tuple(generators) or tuple(GENERATORS[w](size) for w in BENCHMARK)
-        for g in self.generators:
-            if g.frame != self.frame:
-                raise ValueError(f"generators: {g.name} has frame {g.frame}, expected {self.frame}")
-
-    @classmethod
-    def from_config(cls, cfg: ExploreConfig) -> WorldGenerator:
-        """The generators of :data:`BENCHMARK`, each with the settings of ``cfg`` it gets on its own."""
-        return cls(tuple(GENERATORS[w].from_config(cfg) for w in BENCHMARK), size=cfg.world_size)
-
-    def _gen_world(self, rng: np.random.Generator) -> World:
-        return self.generators[int(rng.integers(len(self.generators)))]._gen_world(rng)
-
-
-#: The generators by the name an env config gives them (``ExploreConfig.world``): the one registry.
-GENERATORS: dict[str, type[WorldGenerator]] = {
-    "room": ThesisRoom,
-    "rocks": RockField,
-    "caves": Caves,
-    "rooms": RoomsCorridors,
-    "file": FileMap,
-    "mixed": Mixed,
-}
-#: The generators of the coverage benchmark (:mod:`digslam.agents.evaluation.suite`), in its column order.
-BENCHMARK: tuple[str, ...] = ("room", "rocks", "caves", "rooms")
-
-
-def make_generator(cfg: ExploreConfig) -> WorldGenerator:
-    """The generator that ``cfg.world`` names in :data:`GENERATORS`, built with the settings of ``cfg``
-    (:meth:`WorldGenerator.from_config`).
-
-    Raises:
-        ValueError: ``cfg.world`` names no generator.
-    """
-    if cfg.world not in GENERATORS:
-        raise ValueError(f"world: must be one of {sorted(GENERATORS)}, got {cfg.world!r}")
-    return GENERATORS[cfg.world].from_config(cfg)
-
-
-__all__ = [
-    "BENCHMARK",
-    "Caves",
-    "FileMap",
-    "GENERATORS",
-    "Generator",
-    "Mixed",
-    "RockField",
-    "RoomsCorridors",
-    "THESIS_ROOM",
-    "ThesisRoom",
-    "WorldGenerator",
-    "make_generator",
-]
+__all__ = ["THESIS_ROOM", "Caves", "RockField", "RoomsCorridors", "ThesisRoom"]
