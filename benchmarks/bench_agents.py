@@ -3,19 +3,20 @@
 Every baseline of :data:`digslam.agents.baselines.registry.BASELINES` (and the shipped learned agent
 ``agents/data/goals_attention.zip``, row ``ppo``, the learned chooser of the map predictor's gains
 ``agents/data/goals_predictive.zip``, row ``predictive_chooser``, and the low-level PPO
-``agents/data/ppo_digcoverage.zip``, row ``ppo_lowlevel``, when they exist, each on the env keywords of its ``.json`` sidecar: they change the
-observation, not the levels) runs on the same ``--maps`` levels of each generator of
-:data:`digslam.agents.evaluation.suite.GENERATORS` (room, rocks, caves, rooms): the first seeds of the test
-split (``digslam.envs.splits``), ``target=1.0`` (no early end), ``--steps`` steps
+``agents/data/ppo_digcoverage.zip``, row ``ppo_lowlevel``, when they exist, each on the env keywords of its
+``.json`` sidecar: they change the observation, not the levels) runs on the same ``--maps`` levels of each
+generator of :data:`digslam.agents.evaluation.suite.GENERATORS` (room, rocks, caves, rooms, and floorplan:
+20 m windows of the test split's real floor plans): the first seeds of the test split
+(``digslam.envs.splits``), ``target=1.0`` (no early end), ``--steps`` steps
 (:func:`digslam.agents.evaluation.suite.run_suite`). The headline is ``T_level``, the steps to each
 generator's target level (:data:`digslam.agents.evaluation.levels.TARGET_LEVELS`, fixed on the validation
-split by ``bench_levels.py``). Prints the leaderboard (``T_level`` per generator with its success rate,
-``T_level`` / T90 / AUC / final pose box over all maps, and the geometric-mean speedup over the best
-baseline with its paired bootstrap 95 % interval), writes ``leaderboard.md``, ``leaderboard.png``,
+split by ``bench_levels.py``). Prints the leaderboard as two tables (``T_level`` per generator with its
+success rate; ``T_level`` / T90 / AUC / final pose box over all maps, and the geometric-mean speedup over
+the best baseline with its paired bootstrap 95 % interval), writes ``leaderboard.md``, ``leaderboard.png``,
 ``suite.json`` and ``best.json`` (the best agent overall, learned ones included; copied to
 ``agents/data/leaderboard.json`` it becomes ``digslam demo``'s default agent) to ``--out``, and ends with:
 
-* ``target_levels=room:…,rocks:…,caves:…,rooms:…``;
+* ``target_levels=room:…,rocks:…,caves:…,rooms:…,floorplan:…``;
 * ``best_heuristic_<generator>=`` (the baseline of smallest mean ``T_level`` there) and ``best_heuristic=``
   (over all maps);
 * ``heuristic_level_success=<share of the test maps, over all generators, on which the best heuristic
@@ -41,8 +42,8 @@ does not drift); ``--generators`` runs some generators only; ``--agents`` some a
 frontier``: the reference baseline alone; the best baseline and ``heuristic_level_success`` are then those
 of the agents run); ``--from`` reads the suite JSONs of earlier runs on the same levels (for example one run
 per agent, in parallel processes) and merges them instead of running (the speed figures are still measured
-here). The full suite (4 generators x 30 maps x 3000 steps x 8 agents, about 2.9 M steps) takes about an
-hour on one core; ``--quick`` (3 maps, 300 steps) a minute. ``--ray`` runs the same suite on a pool of Ray
+here). The full suite (5 generators x 30 maps x 3000 steps x 8 agents, about 3.6 M steps) takes about an
+hour and a quarter on one core; ``--quick`` (3 maps, 300 steps) a minute. ``--ray`` runs the same suite on a pool of Ray
 actors (:func:`digslam.agents.evaluation.ray_eval.run_suite_ray`; a local instance with ``--workers`` CPUs,
 or the cluster at ``--address``) with identical results; the speed figures are still measured in this
 process.
@@ -158,7 +159,7 @@ def main() -> None:
                     help="an environment keyword for every agent and generator, e.g. grid_cell=0.078125 "
                          "(repeatable; values parsed as TOML literals)")  # fmt: skip
     ap.add_argument("--generators", nargs="+", default=None, metavar="G",
-                    help="run these generators only (default: room rocks caves rooms)")  # fmt: skip
+                    help="run these generators only (default: room rocks caves rooms floorplan)")  # fmt: skip
     ap.add_argument("--from", dest="sources", nargs="+", type=Path, default=None, metavar="F",
                     help="suite JSONs of earlier runs on the same levels to merge instead of running")  # fmt: skip
     ap.add_argument("--agents", nargs="+", default=None, metavar="A",

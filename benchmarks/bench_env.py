@@ -12,6 +12,14 @@ too. The same env with the exact unicycle dynamics (``dynamics="unicycle"``) is 
 ending in ``_unicycle``). All are timed warm (one untimed run of each first, which also loads the compiled
 kernels), the repeats alternating between them.
 
+Real buildings: the observed env (``digslam/DigCoverage-v0``) on ``world="floorplan"`` levels (windows of
+the shipped KTH plans, whose traced walls have more edges than a rooms level) and on ``world="rooms"``
+levels, otherwise the same settings, runs the same actions on the same seeds (a new level every
+:data:`LEVEL_STEPS` steps, the levels of ``bench_observer.py``), the two alternating in chunks of
+:data:`CHUNK` steps so that a load spike lands on both; ``floorplan_over_rooms`` is the floorplan step rate
+over the rooms one (median of the repeats; the issue's bound: at least 0.7), ``floorplan_over_rooms_unicycle``
+the same with the unicycle dynamics.
+
 Usage: ``python benchmarks/bench_env.py [--steps N] [--repeats R] [--quick]`` (``--quick``: 100 steps, one
 repeat). The last line is
 ``ratio_vs_raycast=<ours / reference>`` (median of the repeats, wall-clock time).
@@ -31,6 +39,10 @@ import digslam.envs  # noqa: F401  (registers the environments)
 from digslam.envs.sim.robot import RobotSim
 
 RAYS_PER_CONE = 5
+#: Steps per level of the floorplan/rooms comparison (resets, untimed, with the seeds 0, LEVEL_STEPS, ...).
+LEVEL_STEPS = 500
+#: Steps per chunk of the floorplan/rooms alternation.
+CHUNK = 100
 
 
 def make_ours(dynamics: str = "pymunk") -> gym.Env:
@@ -85,6 +97,29 @@ def run_reference(env: gym.Env, actions: np.ndarray) -> float:
     return time.perf_counter() - t0
 
 
+def make_observed(world: str, dynamics: str = "pymunk") -> gym.Env:
+    """The observed env on ``world`` levels (the defaults otherwise; no coverage target ends an episode)."""
+    return gym.make("digslam/DigCoverage-v0", world=world, dynamics=dynamics, target=1.0,
+                    max_episode_steps=LEVEL_STEPS + 1)  # fmt: skip
+
+
+def run_levels(envs: list[gym.Env], actions: np.ndarray) -> list[float]:
+    """Total wall time of each env over ``actions``: all reset with the same seed every :data:`LEVEL_STEPS`
+    steps (untimed), the envs taking turns chunk by chunk (:data:`CHUNK` steps)."""
+    times = [0.0] * len(envs)
+    for start in range(0, len(actions), LEVEL_STEPS):
+        for e in envs:
+            e.reset(seed=start)
+        block = actions[start : start + LEVEL_STEPS]
+        for c in range(0, len(block), CHUNK):
+            for i, e in enumerate(envs):
+                t0 = time.perf_counter()
+                for a in block[c : c + CHUNK]:
+                    e.step(a)
+                times[i] += time.perf_counter() - t0
+    return times
+
+
 def sensing_only(env: gym.Env, n: int) -> tuple[float, float]:
     """Sensor calls per second at ``n`` free poses: exact cones vs the reference ray fan (no physics)."""
     u = env.unwrapped
@@ -132,13 +167,22 @@ def main() -> None:
     run_ours(uni, actions[:50])
     run_reference(env, actions[:50])
     env.unwrapped.suite.true_ranges(env.unwrapped.world, env.unwrapped.sim.pose)  # sensing_only's kernel
-    ours, ref, raw, ours_u, raw_u = [], [], [], [], []
+    levels = [make_observed(w, d) for d in ("pymunk", "unicycle") for w in ("rooms", "floorplan")]
+    run_levels(levels, actions[:50])
+    ours, ref, raw, ours_u, raw_u, plan, plan_u = [], [], [], [], [], [], []
     for _ in range(args.repeats):
         ours.append(args.steps / run_ours(env, actions))
         ours_u.append(args.steps / run_ours(uni, actions))
         ref.append(args.steps / run_reference(env, actions))
         raw.append(args.steps / run_ours(env.unwrapped, actions))
         raw_u.append(args.steps / run_ours(uni.unwrapped, actions))
+        t_rooms, t_plan, t_rooms_u, t_plan_u = run_levels(levels, actions)
+        plan.append(t_rooms / t_plan)
+        plan_u.append(t_rooms_u / t_plan_u)
+    plan_edges = []  # the floorplan levels timed (the same seeds give the same levels)
+    for start in range(0, args.steps, LEVEL_STEPS):
+        levels[1].reset(seed=start)
+        plan_edges.append(len(levels[1].unwrapped.world.edges))
     o, r, o_u = float(np.median(ours)), float(np.median(ref)), float(np.median(ours_u))
     s_ours, s_ref = sensing_only(env, args.steps)
     print(
@@ -162,6 +206,12 @@ def main() -> None:
         f"sensing_only: exact_cones_per_s={s_ours:.0f} ray_fan_per_s={s_ref:.0f} ratio={s_ours / s_ref:.3f}"
     )
     print(f"ratio_vs_raycast_unicycle={o_u / r:.3f}")
+    print(
+        f"floorplan levels: {len(plan_edges)}, edges mean {np.mean(plan_edges):.0f} max {max(plan_edges)}; "
+        f"rooms levels: {len(levels[0].unwrapped.world.edges)} edges; observed env (DigCoverage-v0)"
+    )
+    print(f"floorplan_over_rooms_unicycle={float(np.median(plan_u)):.3f}")
+    print(f"floorplan_over_rooms={float(np.median(plan)):.3f}")
     print(f"ratio_vs_raycast={o / r:.3f}")
 
 

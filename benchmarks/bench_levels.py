@@ -5,14 +5,17 @@ Runs the frontier-planning baselines (``--agents``, default frontier, tour_front
 on the first ``--maps`` (24) levels of the **validation** split of every generator, ``--steps`` (3000) steps
 each at the default settings, and prints, per generator, the share of the levels each baseline reaches each
 candidate level on (0.80, 0.85, 0.90, 0.95) with its mean time, then the chosen level and the baseline that
-fixed it. ``--from F ...`` reads suite JSONs written by this script or by ``bench_agents.py`` (runs of other
-agents on the same levels merge) instead of running. The last lines are ``target_levels=room:…,rocks:…``,
+fixed it. ``--generators G ...`` runs some generators only; ``--set KEY=VALUE`` gives every episode an
+environment keyword (``--generators floorplan --set world_size=7.5``: the floorplan levels on 15 m windows
+instead of the suite's, the run that chooses the window size). ``--from F ...`` reads suite JSONs written
+by this script or by ``bench_agents.py`` (runs of other agents on the same levels merge) instead of running. The last lines are ``target_levels=room:…,rocks:…``,
 ``shipped_levels=`` (:data:`~digslam.agents.evaluation.levels.TARGET_LEVELS`, what the benchmark uses) and
 ``levels_match=1`` when the two agree.
 
 Usage: ``python benchmarks/bench_levels.py [--quick] [--maps 24] [--steps 3000] [--agents A ...] [--out DIR]
-[--from F ...]``. The full run is 3 baselines x 4 generators x 24 levels x 3000 steps (about 0.9 M steps,
-some 10 minutes a baseline on one core); ``--quick`` runs 2 room levels of 300 steps with the frontier agent.
+[--generators G ...] [--set KEY=VALUE ...] [--from F ...]``. The full run is 3 baselines x 5 generators x
+24 levels x 3000 steps (about 1.1 M steps, some 12 minutes a baseline on one core; the floorplan levels
+alone about 2 minutes for the three); ``--quick`` runs 2 room levels of 300 steps with the frontier agent.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from __future__ import annotations
 import argparse
 import time
 from pathlib import Path
+from typing import Any
 
 import gymnasium as gym
 
@@ -35,11 +39,28 @@ from digslam.agents.evaluation.levels import (
     format_levels,
     reach_shares,
 )
-from digslam.agents.evaluation.suite import SuiteResult, merge, run_suite
+from digslam.agents.evaluation.suite import SuiteResult, check_generators, merge, run_suite
 
 ENV_ID = "digslam/DigCoverage-v0"
 #: The baselines the levels are chosen over (the planners; random and lawnmower are far behind).
 CANDIDATES = ("frontier", "tour_frontier", "distance_advantage")
+
+
+def env_settings(items: list[str]) -> dict[str, Any]:
+    """``--set KEY=VALUE`` items as environment keywords (values parsed as TOML literals, else strings).
+
+    Raises:
+        ValueError: an item without ``=``.
+    """
+    from digslam.observer.core.config import parse_value
+
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, raw = item.partition("=")
+        if not sep or not key.strip():
+            raise ValueError(f"--set: expected KEY=VALUE, got {item!r}")
+        out[key.strip()] = parse_value(raw.strip())
+    return out
 
 
 def main() -> None:
@@ -51,6 +72,11 @@ def main() -> None:
     ap.add_argument("--agents", nargs="+", default=list(CANDIDATES), metavar="A", help="the baselines to run")
     ap.add_argument("--quick", action="store_true", help="a smoke run: 2 room levels, 300 steps, frontier")
     ap.add_argument("--out", type=Path, default=Path("out/levels"), help="where to write suite.json")
+    ap.add_argument("--generators", nargs="+", default=None, metavar="G",
+                    help="run these generators only (default: every generator of the suite)")  # fmt: skip
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="an environment keyword for every agent and generator, e.g. world_size=7.5 "
+                         "(repeatable; values parsed as TOML literals)")  # fmt: skip
     ap.add_argument("--from", dest="sources", nargs="+", type=Path, default=None, metavar="F",
                     help="suite JSONs to read instead of running (merged)")  # fmt: skip
     args = ap.parse_args()
@@ -59,6 +85,12 @@ def main() -> None:
         ap.error(f"--agents: unknown {unknown}; known: {sorted(BASELINES)}")
     if args.maps < 1 or args.steps < 1:
         ap.error(f"--maps, --steps: must be >= 1, got {args.maps}, {args.steps}")
+    try:
+        common = env_settings(args.set)
+        gym.make(ENV_ID, **common).close()  # an unknown key or a bad value: one line, before any episode
+        check_generators(args.generators)
+    except ValueError as exc:
+        ap.error(str(exc).splitlines()[0])
     t0 = time.perf_counter()
     if args.sources:
         missing = [str(p) for p in args.sources if not p.is_file()]
@@ -75,10 +107,10 @@ def main() -> None:
         env = gym.make(ENV_ID)
         policies = {n: make_baseline(n, env, seed=0) for n in names}
         env.close()
-        gens = ["room"] if args.quick else None
-        res = run_suite(
-            policies, n_maps=maps, steps=steps, split="validation", generators=gens, progress=True
-        )
+        gens = ["room"] if args.quick else args.generators
+        extra = {n: dict(common) for n in names} if common else None
+        res = run_suite(policies, n_maps=maps, steps=steps, split="validation", generators=gens,
+                        agent_env_kwargs=extra, progress=True)  # fmt: skip
         args.out.mkdir(parents=True, exist_ok=True)
         print(f"wrote {res.to_json(args.out / 'suite.json')}")
     print(f"{len(res.seeds)} validation levels per generator (seeds {res.seeds[0]}..{res.seeds[-1]}), "

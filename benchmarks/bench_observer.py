@@ -29,6 +29,14 @@ The envs move the robot with pymunk, the default dynamics (the record then bound
 and the filter's tube grows with it). The same pair (raw, observed at ``q = 0``) with the exact unicycle
 dynamics runs afterwards on the same actions and seeds; its figures end in ``_unicycle``.
 
+Real buildings: the observed env (``digslam/DigCoverage-v0``, ``q = 0``) on ``world="floorplan"`` levels
+(windows of the shipped KTH plans, :class:`~digslam.envs.sim.generators.Floorplan`) and on ``world="rooms"``
+levels, otherwise the same settings, run the same actions and seeds in alternating chunks as above (the
+floorplan env's update times are read each step, the rooms env's are not: the ratio leans conservative);
+``floorplan_over_rooms`` is the floorplan levels' step rate over the rooms levels' (the issue's bound: at
+least 0.7), ``floorplan_edges_mean`` the mean number of edges of the floorplan levels timed (each sensor
+reads the edges that its bounding-box pre-filter keeps).
+
 Usage: ``python benchmarks/bench_observer.py [--steps N] [--episode K] [--chunk C] [--grid-cell S] [--quick]``
 (``S``: the observer's cell side, m; 0.078125 for the grid twice as fine; ``--quick``: 200 steps in episodes of
 100, a smoke run). Last line:
@@ -150,6 +158,17 @@ def main() -> None:
     t_raw_u, t_obs_u = run_pair(raw_u, [obs_u], actions, args.episode, args.chunk, probe_u)
     up_u = np.array(probe_u[0])
     raw_sps_u, obs_sps_u = args.steps / t_raw_u, args.steps / t_obs_u
+    rooms, plan = (
+        gym.make("digslam/DigCoverage-v0", world=w, max_episode_steps=steps, target=1.0, **cell)
+        for w in ("rooms", "floorplan")
+    )
+    run_pair(rooms, [plan], actions[:50], 50, 50, [[]])  # warm-up
+    probe_f: list[list[float]] = [[]]
+    t_rooms, t_plan = run_pair(rooms, [plan], actions, args.episode, args.chunk, probe_f)
+    plan_edges = []  # the floorplan levels timed (resets with the same seeds give the same levels)
+    for start in range(0, args.steps, args.episode):
+        plan.reset(seed=start)
+        plan_edges.append(len(plan.unwrapped.world.edges))
     layer = observer_of(obs)
     print(f"grid={layer.grid.shape} map={layer.obs_config.map_size} sensors={raw.unwrapped.suite.n}")
     print(f"raw_steps_per_s={raw_sps:.0f}")
@@ -174,6 +193,12 @@ def main() -> None:
     print(f"observed_steps_per_s_unicycle={obs_sps_u:.0f}")
     print(f"observer_update_median_ms_unicycle={1e3 * np.median(up_u):.3f}")
     print(f"observer_overhead_unicycle={raw_sps_u / obs_sps_u:.3f}")
+    print(f"observed_steps_per_s_rooms={args.steps / t_rooms:.0f}")
+    print(f"observed_steps_per_s_floorplan={args.steps / t_plan:.0f}")
+    print(f"observer_update_median_ms_floorplan={1e3 * np.median(probe_f[0]):.3f}")
+    n_rooms = len(rooms.unwrapped.world.edges)
+    print(f"floorplan_edges_mean={np.mean(plan_edges):.0f}  (max {max(plan_edges)}; rooms level: {n_rooms})")
+    print(f"floorplan_over_rooms={t_rooms / t_plan:.3f}")
     print(f"observed_steps_per_s={obs_sps:.0f}")
     print(f"observer_update_median_ms={1e3 * np.median(up):.3f}")
     print(f"observer_update_p99_ms={1e3 * np.percentile(up, 99):.3f}")

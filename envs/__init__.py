@@ -3,12 +3,15 @@
 Importing this package registers ``digslam/Explore-v0`` (the thesis room of Fig. 6.10) and its variants
 (:data:`ENV_IDS`), and the certified-coverage ``digslam/DigCoverage-v0`` and its variants
 (:data:`COVERAGE_IDS`: omni-only, sonar-only, large caves, adversarial noise, 10x odometry noise (stress),
-and unflagged outliers, at most
-one per step, under the observer's q-relaxed mode with ``q = 1``; ``ExploreOutliers-v0`` caps its outliers
-at one per step too). Every environment is procedural: the seed passed to ``reset`` picks a new world and a
-new reachable start pose (a level), and :mod:`.splits` fixes the train, validation and test levels
-(``ExploreConfig.map_seed`` pins one world for debugging). In worker processes that
-have not imported it (e.g. SB3's ``SubprocVecEnv`` with forkserver), use the
+and unflagged outliers, at most one per step, under the observer's q-relaxed mode with ``q = 1``;
+``ExploreOutliers-v0`` caps its outliers at one per step too). The seed passed to ``reset`` picks a new world
+and a new reachable start pose (a level), and :mod:`.splits` fixes the train, validation and test levels
+(``ExploreConfig.map_seed`` pins one world for debugging). Most worlds are procedural; those of
+``digslam/ExploreFloorplan-v0`` and ``digslam/DigCoverageFloorplan-v0`` are square windows of real building
+floor plans (the KTH plans shipped with the package, or the user's ROS map files and plans with
+``floorplans=``; :class:`~.sim.generators.floorplan.Floorplan`), :data:`FLOORPLAN_WORLD_SIZE` metres in
+half-width (the benchmark's floorplan levels), and the reset seed's split chooses the plans they are cut from.
+In worker processes that have not imported it (e.g. SB3's ``SubprocVecEnv`` with forkserver), use the
 ``"digslam.envs:digslam/Explore-v0"`` form, which imports the module first.
 
 The certified-coverage observation is laid out once in :mod:`.observation` (:class:`Channel`,
@@ -28,6 +31,7 @@ from digslam.envs.observation import N_STATE, Channel, State
 from digslam.envs.sim.generators import (
     BENCHMARK,
     GENERATORS,
+    PROCEDURAL,
     Caves,
     FileMap,
     Generator,
@@ -46,6 +50,9 @@ _origin.warn_if_shadowed(__name__)
 
 
 MAX_EPISODE_STEPS = 1000
+#: Half-width (m) of the floorplan ids' frame, and of the benchmark's floorplan levels: 20 m windows of the
+#: plans (the largest on which the level rule vouches for a level: ``docs/benchmark.md``).
+FLOORPLAN_WORLD_SIZE = 10.0
 
 #: Registered ids and their keyword arguments (all share ``ExploreEnv`` and ``MAX_EPISODE_STEPS``).
 ENV_IDS: dict[str, dict[str, object]] = {
@@ -53,7 +60,7 @@ ENV_IDS: dict[str, dict[str, object]] = {
     "digslam/ExploreRocks-v0": {"world": "rocks"},
     "digslam/ExploreCaves-v0": {"world": "caves"},
     "digslam/ExploreRooms-v0": {"world": "rooms"},
-    "digslam/ExploreFloorplan-v0": {"world": "floorplan"},
+    "digslam/ExploreFloorplan-v0": {"world": "floorplan", "world_size": FLOORPLAN_WORLD_SIZE},
     "digslam/ExploreAdversarial-v0": {"noise": {"model": "adversarial"}},
     "digslam/ExploreOutliers-v0": {"world": "rocks", "noise": {"outlier_prob": 0.05, "max_outliers": 1}},
 }
@@ -64,7 +71,7 @@ COVERAGE_IDS: dict[str, dict[str, object]] = {
     "digslam/DigCoverageOmni-v0": {"n_sonars": 0},
     "digslam/DigCoverageSonar-v0": {"omni": False},
     "digslam/DigCoverageCaves-v0": {"world": "caves", "world_size": 20.0},
-    "digslam/DigCoverageFloorplan-v0": {"world": "floorplan"},
+    "digslam/DigCoverageFloorplan-v0": {"world": "floorplan", "world_size": FLOORPLAN_WORLD_SIZE},
     "digslam/DigCoverageAdversarial-v0": {"noise": {"model": "adversarial"}},
     # the tube matters: odometry 10x noisier than the default, so an agent that never returns to known walls
     # loses its pose (the impacts on known walls are what narrows the pose box again)
@@ -106,6 +113,7 @@ def __getattr__(name: str) -> object:
 
 __all__ = [
     "BENCHMARK",
+    "PROCEDURAL",
     "COVERAGE_IDS",
     "Channel",
     "GENERATORS",
@@ -121,6 +129,7 @@ __all__ = [
     "GuaranteedObserver",
     "ObserverConfig",
     "ENV_IDS",
+    "FLOORPLAN_WORLD_SIZE",
     "Caves",
     "Episode",
     "ExploreConfig",

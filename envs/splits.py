@@ -1,4 +1,4 @@
-"""Seed splits of the procedural environments: train, validation and test levels (Procgen / MiniGrid style).
+"""Seed splits of the environments: train, validation and test levels (Procgen / MiniGrid style).
 
 Every registered environment builds a new world and a new start pose from the seed passed to ``reset``
 (:class:`~digslam.envs.config.ExploreConfig`: ``fixed_world=False``, ``room_jitter``, ``start_rule``), so a
@@ -15,6 +15,20 @@ seed *is* a level. The levels are split once and for all:
 ('train', 'validation', 'test', None)
 >>> seeds("test", 3)
 [2000000, 2000001, 2000002]
+
+**Real buildings: split by plan.** On ``world="floorplan"`` with the shipped plans, a level is a window of
+one of ten KTH floor plans, and the split of the reset's seed also chooses the *plans* its window is cut
+from (:data:`digslam.envs.sim.generators.floorplan.SPLIT`; an unseeded reset counts as ``train``): six
+plans train, two validate, two test. Windows of one plan overlap and floors of one building look alike, so
+a split of the seeds alone would show a test level's walls in training; split by plan, no window of a test
+level comes from a plan that training or validation uses. Which plan goes where, and why, is
+:data:`~digslam.envs.sim.generators.floorplan.SPLIT`'s comment. A seed outside every split draws from all
+ten plans, and with the user's maps (``floorplans=[...]``) every seed is a level of any map: no split
+applies.
+
+>>> from digslam.envs.sim.generators.floorplan import SPLIT
+>>> {split: len(plans) for split, plans in SPLIT.items()}
+{'train': 6, 'validation': 2, 'test': 2}
 """
 
 from __future__ import annotations

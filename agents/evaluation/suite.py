@@ -6,8 +6,8 @@ benchmark's generators of the world registry, :data:`digslam.envs.sim.generators
 every agent), each episode with ``target=1.0`` (no early end: the curve is not capped) and a step budget of
 ``steps`` (3000). :class:`SuiteResult` turns the curves into the metrics of :mod:`.metrics` per generator
 and writes the leaderboard. Its headline is ``T_level``, the steps to each generator's target level
-(:data:`.levels.TARGET_LEVELS`, fixed on the validation split): a Markdown table (per agent: ``T_level`` per
-generator with its success rate, and over all maps ``T_level``, T90, AUC and the final pose box, the
+(:data:`.levels.TARGET_LEVELS`, fixed on the validation split): two Markdown tables (per agent: ``T_level``
+per generator with its success rate; and over all maps ``T_level``, T90, AUC and the final pose box, the
 geometric mean over the maps of ``T_level(best baseline) / T_level(agent)`` with its paired bootstrap 95 %
 interval) and a figure (``T_level`` per generator, and the mean certified coverage curves with their
 spread).
@@ -35,15 +35,22 @@ from digslam.agents.common.policy import PolicyFactory, PolicyPredictor, reset_p
 from digslam.agents.evaluation.evaluate import EvalResult, evaluate
 from digslam.agents.evaluation.levels import TARGET_LEVELS, level_metric
 from digslam.agents.evaluation.metrics import paired_bootstrap_geomean
+from digslam.envs import FLOORPLAN_WORLD_SIZE
 from digslam.envs.config import ExploreConfig
 from digslam.envs.sim.generators import BENCHMARK
 
 #: The environment id every suite episode runs on (the world is a keyword).
 SUITE_ENV = "digslam/DigCoverage-v0"
+#: Generator -> the keywords of its levels beside ``world``: the floorplan levels are windows of
+#: ``2 * FLOORPLAN_WORLD_SIZE`` metres (:data:`digslam.envs.FLOORPLAN_WORLD_SIZE`, as
+#: ``digslam/DigCoverageFloorplan-v0``), the procedural ones the default frame.
+WORLD_KWARGS: dict[str, dict[str, Any]] = {"floorplan": {"world_size": FLOORPLAN_WORLD_SIZE}}
 #: Generator name -> (environment id, keywords): the suite's worlds, those of
-#: :data:`~digslam.envs.sim.generators.BENCHMARK` in its order (the default world needs no keyword).
+#: :data:`~digslam.envs.sim.generators.BENCHMARK` in its order (the default world needs no keyword), each
+#: with its :data:`WORLD_KWARGS`.
 GENERATORS: dict[str, tuple[str, dict[str, Any]]] = {
-    name: (SUITE_ENV, {} if name == ExploreConfig.world else {"world": name}) for name in BENCHMARK
+    name: (SUITE_ENV, ({} if name == ExploreConfig.world else {"world": name}) | WORLD_KWARGS.get(name, {}))
+    for name in BENCHMARK
 }
 #: What every suite episode runs with: no early end, so the metric is not capped at 0.8.
 SUITE_KWARGS: dict[str, Any] = {"target": 1.0}
@@ -116,33 +123,40 @@ class SuiteResult:
         return float(np.mean(np.concatenate(flags)))
 
     def table(self, baselines: Sequence[str]) -> str:
-        """The leaderboard (Markdown), agents sorted by mean ``T_level`` over all maps (then AUC); the ratio
-        column is the geometric mean over the maps of ``T_level(best baseline) / T_level(agent)`` (> 1:
-        faster than the best baseline) with its paired bootstrap 95 % interval."""
+        """The leaderboard (Markdown): the two tables of :meth:`tables`, a blank line between them."""
+        return "\n\n".join(self.tables(baselines))
+
+    def tables(self, baselines: Sequence[str]) -> tuple[str, str]:
+        """The leaderboard as two Markdown tables, agents sorted by mean ``T_level`` over all maps (then AUC)
+        in both: per generator, ``T_level`` with its success rate; over all maps, ``T_level`` (success),
+        T90, AUC, the final pose box and the ratio column, the geometric mean over the maps of
+        ``T_level(best baseline) / T_level(agent)`` (> 1: faster than the best baseline) with its paired
+        bootstrap 95 % interval. (Two tables, so that each fits a page's width.)"""
         m, t, t90 = self.metrics(), self.times(), self.times("T90")
         best = self.best(baselines) if any(b in t for b in baselines) else None
         gens = list(self.results)
         head = ["agent"] + [f"{self.level_name(g)} {g} (success)" for g in gens]
-        head += ["T_level all (success)", "T90 all", "AUC", "final pose box (m)",
+        head2 = ["agent", "T_level all (success)", "T90 all", "AUC", "final pose box (m)",
                  "speedup vs best baseline [95 % CI]"]  # fmt: skip
         lines = ["| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
+        lines2 = ["| " + " | ".join(head2) + " |", "|---" * len(head2) + "|"]
         for a in sorted(self.agents, key=self._rank):
             cells = [a]
             for g in gens:
                 lv = self.level_name(g)
                 cells.append(f"{np.mean(m[g][a][lv]):.0f} ({np.mean(m[g][a]['S' + lv[1:]]):.0%})")
+            lines.append("| " + " | ".join(cells) + " |")
             auc = np.concatenate([m[g][a]["AUC"] for g in gens])
             box = np.concatenate([m[g][a]["final_tube"] for g in gens])
-            cells.append(f"{np.mean(t[a]):.0f} ({self.success(a):.0%})")
-            cells.append(f"{np.mean(t90[a]):.0f}")
+            cells = [a, f"{np.mean(t[a]):.0f} ({self.success(a):.0%})", f"{np.mean(t90[a]):.0f}"]
             cells += [f"{np.mean(auc):.3f}", f"{np.nanmean(box):.3f}" if np.isfinite(box).any() else "n/a"]
             if best is None:
                 cells.append("n/a")
             else:
                 r, lo, hi = paired_bootstrap_geomean(t[best], t[a])
                 cells.append(f"{r:.3f} [{lo:.3f}, {hi:.3f}]" + (" (best baseline)" if a == best else ""))
-            lines.append("| " + " | ".join(cells) + " |")
-        return "\n".join(lines)
+            lines2.append("| " + " | ".join(cells) + " |")
+        return "\n".join(lines), "\n".join(lines2)
 
     def figure(self, path: str | Path) -> Path:
         """``T_level`` per generator (bars, mean over the maps, with the spread as error bars) beside the mean
@@ -365,6 +379,7 @@ __all__ = [
     "SUITE_ENV",
     "SUITE_KWARGS",
     "SuiteResult",
+    "WORLD_KWARGS",
     "check_generators",
     "eval_rates",
     "merge",

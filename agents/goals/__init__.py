@@ -1,7 +1,8 @@
 """Goal selection: certified coverage as a choice among candidate goals, driven by the frontier agent's loop.
 
 Importing this package registers ``digslam/DigCoverageGoals-v0`` (room) and ``DigCoverageGoalsRocks-v0``,
-``DigCoverageGoalsCaves-v0``, ``DigCoverageGoalsRooms-v0`` (:data:`GOAL_IDS`); in worker processes use
+``DigCoverageGoalsCaves-v0``, ``DigCoverageGoalsRooms-v0``, ``DigCoverageGoalsFloorplan-v0``
+(:data:`GOAL_IDS`, one per generator of the benchmark); in worker processes use
 ``"digslam.agents.goals:digslam/DigCoverageGoals-v0"``.
 
 Lives here: :mod:`.driver` (``GoalDriver``: the frontier agent's loop towards a fixed goal, and the events

@@ -12,6 +12,7 @@ from __future__ import annotations
 import gymnasium as gym
 
 import digslam.envs  # noqa: F401  (registers the base ids the goal ids wrap)
+from digslam.envs import FLOORPLAN_WORLD_SIZE
 
 #: Entry point of every id.
 ENTRY_POINT = "digslam.agents.goals.env:GoalSelectionEnv"
@@ -21,6 +22,11 @@ GOAL_IDS: dict[str, dict[str, object]] = {
     "digslam/DigCoverageGoalsRocks-v0": {"base_id": "digslam/DigCoverage-v0", "world": "rocks"},
     "digslam/DigCoverageGoalsCaves-v0": {"base_id": "digslam/DigCoverage-v0", "world": "caves"},
     "digslam/DigCoverageGoalsRooms-v0": {"base_id": "digslam/DigCoverage-v0", "world": "rooms"},
+    "digslam/DigCoverageGoalsFloorplan-v0": {
+        "base_id": "digslam/DigCoverage-v0",
+        "world": "floorplan",
+        "world_size": FLOORPLAN_WORLD_SIZE,
+    },
 }
 
 

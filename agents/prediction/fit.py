@@ -48,9 +48,11 @@ KIND = "map_predictor"
 
 
 def _generators() -> list[str]:
-    from digslam.agents.evaluation.suite import GENERATORS
+    """The procedural generators (:data:`digslam.envs.PROCEDURAL`): the data the shipped predictor was fitted
+    on; floorplan windows join only when a config names them."""
+    from digslam.envs import PROCEDURAL
 
-    return list(GENERATORS)
+    return list(PROCEDURAL)
 
 
 @config_dataclass

@@ -185,7 +185,7 @@ class DigCoverageEnv(GuaranteedObserver):
         rr, cc = px(x, y)
         rad = max(int(raw.config.robot_radius * sx), 2)
         yy, xx = np.ogrid[:h, :w]
-        out[(yy - rr) ** 2 + (xx - cc) ** 2 <= rad * rad] = (20, 160, 60)
+        out[:h, :w][(yy - rr) ** 2 + (xx - cc) ** 2 <= rad * rad] = (20, 160, 60)
         if f.consistent:
             (r0, c0), (r1, c1) = px(f.pose_lo[0], f.pose_hi[1]), px(f.pose_hi[0], f.pose_lo[1])
             out[r0 : r1 + 1, [c0, c1]] = 0

@@ -46,7 +46,7 @@ from digslam.envs.config import ExploreConfig
 from digslam.envs.explore.coverage import Coverage
 from digslam.envs.explore.truth import GroundTruth
 from digslam.envs.sim.arc_jit import exact_duration
-from digslam.envs.sim.generators import Generator, make_generator
+from digslam.envs.sim.generators import Generator, WorldGenerator, make_generator
 from digslam.envs.sim.noise_jit import obs_kernel
 from digslam.envs.sim.robot import RobotSim
 from digslam.envs.sim.sensors import SensorSuite, record_step
@@ -139,10 +139,13 @@ class ExploreEnv(gym.Env):
                 self.world, self._world_seed = self.generator.generate(cfg.map_seed), cfg.map_seed
         elif seed is not None or self.world is None or not cfg.fixed_world:
             self._world_seed = int(self.np_random.integers(2**31 - 1))
-            # the split of the reset seed (an unseeded reset draws a training level): a generator of real
-            # maps keeps each map to one split
-            split = split_of(seed) if seed is not None else "train"
-            self.world = self.generator.generate(self._world_seed, split=split)
+            gen = self.generator
+            if isinstance(gen, WorldGenerator):  # the registry's take the split of the reset seed (an
+                # unseeded reset draws a training level): a generator of real maps keeps each to one split
+                split = split_of(seed) if seed is not None else "train"
+                self.world = gen.generate(self._world_seed, split=split)
+            else:  # any other Generator: one world per seed
+                self.world = gen.generate(self._world_seed)
         skin = 1.5 * cfg.max_speed * cfg.dt / cfg.substeps
         if cfg.start is not None:
             pose = np.asarray(cfg.start, dtype=np.float64)

@@ -17,11 +17,12 @@ the mask closed. Loaders:
 
 Doors. Tracing pixel borders is exact: a gap of ``k`` free pixels is ``k * resolution`` metres wide in the
 world, and no loader ever narrows a gap (the outside rule only removes free space that is not the building's
-floor). A robot disc of radius ``r`` passes a gap wider than ``2 r`` (0.4 m for the default 0.2 m; the
-pymunk collision disc adds the skin, 0.0375 m with the default settings, so 0.475 m). The passage test of
+floor). A robot disc of radius ``r`` passes a gap wider than ``2 r`` (0.4 m for the default 0.2 m; the pymunk
+collision disc adds the skin, 0.0375 m with the default settings, so 0.475 m). The passage test of
 :func:`disc_reachable` (a disc centred on a pixel centre fits when the centre lies ``r + resolution / sqrt 2``
-from every non-free pixel centre) opens gaps of at least 5 px at 0.1 m/px (0.5 m) and 9 px at 0.05 m/px
-(0.45 m). A narrower slit (0.4 m or less at 0.1 m/px) stays free in the map and in the world, but is closed
+from every non-free pixel centre) opens gaps of at least 5 px at 0.1 m/px (0.5 m) and 9 px at 0.05 m/px (0.45
+m: the unicycle passes it, the pymunk disc does not; ``Floorplan(clearance=0.24)`` matches the pymunk robot on
+such maps). A narrower slit (0.4 m or less at 0.1 m/px) stays free in the map and in the world, but is closed
 to the robot: the simulator decides passability by geometry. The doors of the shipped plans are 0.8-1.6 m.
 
 Errors: bad input raises one ``ValueError`` line naming the file and the key, and saying what to do.

@@ -29,10 +29,13 @@ the filter's and its dark cells contain the filter's (same ``impacts``, ``cones`
 ``q``; ``tests/observer/online/test_smoother.py``). An empty box means the data contradict their bounds:
 the result then says so (``consistent`` is False) and carries no sets.
 
-Cost per step of record: one filter step (about 20 µs), then per iteration one impact contraction per
-box, one cone contraction per box wider than :data:`.step_jit.CONE_MIN_WIDTH` and the digging of the boxes
-that shrank; 3000 steps of the coverage environment take about 0.3–1 s, and the §6.4.2 loop (12,001
-samples) a few seconds (``benchmarks/bench_digslam.py``).
+Cost per step of record: one filter step (about 50 µs on the §6.4.2 loop; its impact contraction decides
+the cells of a wide box a row at a time, :func:`.pose_jit.contract`), then per iteration one impact
+contraction per box, one cone contraction per box wider than :data:`.step_jit.CONE_MIN_WIDTH` and the
+digging of the boxes that shrank; 3000 steps of the coverage environment take about 0.3–1 s, and the §6.4.2
+loop (12,001 samples) less than Algorithm 6.3 as written,
+:func:`~digslam.observer.slam.digslam.thesis_dig_slam` (about 0.3–0.5 of its time;
+``benchmarks/bench_digslam.py`` prints ``dig_slam_over_thesis``).
 
 The data contract is :mod:`digslam.observer.record.mission`'s: ``speed[k]``, ``lateral[k]`` and
 ``yaw_rate[k]`` bound the truth over the slice ``[t_{k-1}, t_k]`` that ends at ``t_k``; ``heading[k]`` bounds

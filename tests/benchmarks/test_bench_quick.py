@@ -35,16 +35,18 @@ KEYS: dict[str, tuple[str, ...]] = {
         "bench_cold_start": "cold_first_contract_s warm_first_contract_s cold_over_warm_contract",
         "bench_levels": "levels_match",
         "bench_digslam": "seconds offline_over_online_coverage offline_over_online_coverage_min "
-        "offline_over_online_coverage_rooms truth_in_offline_tube",
+        "offline_over_online_coverage_rooms truth_in_offline_tube dig_slam_over_thesis",
         "bench_env": "ours_steps_per_s ours_unwrapped_steps_per_s ours_steps_per_s_unicycle hard_stops "
-        "reference_steps_per_s ratio_vs_raycast_unicycle ratio_vs_raycast",
+        "reference_steps_per_s ratio_vs_raycast_unicycle ratio_vs_raycast floorplan_over_rooms "
+        "floorplan_over_rooms_unicycle",
         "bench_interval": "ratio_vs_codac",
         "bench_localization": "detections truth_inside iterations seconds",
         "bench_observer": "raw_steps_per_s observed_steps_per_s_q1 observer_overhead_q1 observed_q1_over_q0 "
         "observer_overhead_unicycle observed_steps_per_s observer_update_median_ms observer_overhead "
-        "observer_overhead_loop observer_update_p99_ms_loop",
+        "observer_overhead_loop observer_update_p99_ms_loop floorplan_over_rooms",
         "bench_paver": "ratio_vs_codac",
-        "bench_predictor": "predictor_iou_dark predictor_accuracy predictor_ece base_rate_iou dilate_iou",
+        "bench_predictor": "predictor_iou_dark predictor_iou_floorplan predictor_accuracy predictor_ece base_rate_iou "
+        "dilate_iou",
         "bench_polar": "ratio_vs_codac",
         "bench_sweep": "speedup",
         "bench_teacher": "levels rollout_speedup_t90 fresh_noise_speedup_t90",

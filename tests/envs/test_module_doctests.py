@@ -9,7 +9,7 @@ import importlib
 import pytest
 
 
-@pytest.mark.parametrize("name", ["observation", "stack", "sim.generators", "sim.robot"])
+@pytest.mark.parametrize("name", ["observation", "splits", "stack", "sim.generators", "sim.robot"])
 def test_module_doctests(name: str) -> None:
     mod = importlib.import_module(f"digslam.envs.{name}")
     res = doctest.testmod(mod, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)

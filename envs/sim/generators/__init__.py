@@ -11,8 +11,10 @@ caves, rooms off corridors), :mod:`.mixed` (one of several per level), :mod:`.fi
 the frame) and :mod:`.floorplan` (windows of real floor plans at metric scale, from
 :mod:`digslam.envs.sim.occupancy`).
 
->>> sorted(GENERATORS), BENCHMARK
-(['caves', 'file', 'floorplan', 'mixed', 'rocks', 'room', 'rooms'], ('room', 'rocks', 'caves', 'rooms'))
+>>> sorted(GENERATORS)
+['caves', 'file', 'floorplan', 'mixed', 'rocks', 'room', 'rooms']
+>>> BENCHMARK
+('room', 'rocks', 'caves', 'rooms', 'floorplan')
 """
 
 from __future__ import annotations
@@ -38,8 +40,9 @@ GENERATORS: dict[str, type[WorldGenerator]] = {
     "mixed": Mixed,
     "floorplan": Floorplan,
 }
-#: The generators of the coverage benchmark (:mod:`digslam.agents.evaluation.suite`), in its column order.
-BENCHMARK: tuple[str, ...] = PROCEDURAL
+#: The generators of the coverage benchmark (:mod:`digslam.agents.evaluation.suite`), in its column order:
+#: the procedural ones (:data:`~.base.PROCEDURAL`, what ``world="mixed"`` draws from), then real floor plans.
+BENCHMARK: tuple[str, ...] = (*PROCEDURAL, "floorplan")
 
 
 def make_generator(cfg: ExploreConfig) -> WorldGenerator:

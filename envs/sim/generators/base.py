@@ -20,12 +20,12 @@ PROCEDURAL: tuple[str, ...] = ("room", "rocks", "caves", "rooms")
 
 class Generator(Protocol):
     """What an env needs of a world generator: the frame its worlds lie in, and one world per seed (the same
-    seed and split, the same world)."""
+    seed, the same world). A :class:`WorldGenerator` also takes the split of the env's reset seed."""
 
     @property
     def frame(self) -> tuple[float, float, float, float]: ...
 
-    def generate(self, seed: int | None = None, split: str | None = None) -> World: ...
+    def generate(self, seed: int | None = None) -> World: ...
 
 
 class WorldGenerator:

@@ -22,8 +22,14 @@ if TYPE_CHECKING:  # (only the config's fields are read)
 
 class FileMap(WorldGenerator):
     """A map from a file: JSON ``{"frame": [x0, y0, x1, y1], "rings": [[[x, y], ...], ...]}`` (free where the
-    crossing count is odd), or a binary image (``.npy`` bool array, or ``.png``/``.bmp`` where bright is free)
-    stretched over ``[-size, size]^2``."""
+    crossing count is odd; its own frame and coordinates), or a binary image (``.npy`` bool array, or
+    ``.png``/``.bmp`` where bright is free) stretched over ``[-size, size]^2`` whatever its size and aspect
+    ratio, its border pixels closed.
+
+    An image has no metric scale here: a pixel is ``2 * size / cols`` by ``2 * size / rows`` metres. For a
+    map at metric scale (a ROS map YAML file, a floor-plan ``.npz``, an image with its resolution) use
+    ``world="floorplan"`` with ``floorplans=[...]`` (:class:`~.floorplan.Floorplan`), which loads it with
+    :func:`~digslam.envs.sim.occupancy.load_map`."""
 
     name = "file"
 

@@ -27,7 +27,10 @@ def test_suite_runs_every_agent_on_the_same_test_levels_and_writes_the_leaderboa
     assert set(m["room"]["frontier"]) >= {"T80", "T90", "T95", "S90", "AUC", "path_length", "final_tube"}
     assert np.all(res.t90()["random"] == 40)  # 0.9 is out of reach in 40 steps: the budget
     table = res.table(["random", "frontier"])
-    assert table.count("\n") == 3 and "T90 rooms" not in table and "(best baseline)" in table
+    levels, overall = res.tables(["random", "frontier"])
+    assert table == levels + "\n\n" + overall  # two tables: per generator, and over all maps
+    assert levels.count("\n") == overall.count("\n") == 3 and "T90 rooms" not in table
+    assert "T95 room (success)" in levels and "speedup" not in levels and "(best baseline)" in overall
     assert res.best(["random", "frontier"]) == "frontier"  # the same T90: the larger AUC wins
     assert res.figure(tmp_path / "lb.png").stat().st_size > 10_000
     data = json.loads(res.to_json(tmp_path / "suite.json").read_text())
@@ -41,7 +44,25 @@ def test_suite_runs_every_agent_on_the_same_test_levels_and_writes_the_leaderboa
     assert steps_per_second(agents["frontier"], steps=30) > 0
     with pytest.raises(ValueError, match="generators"):
         run_suite(agents, n_maps=1, steps=5, generators=["moon"])
-    assert set(GENERATORS) == {"room", "rocks", "caves", "rooms"}
+    assert list(GENERATORS) == ["room", "rocks", "caves", "rooms", "floorplan"]
+
+
+def test_the_floorplan_levels_are_windows_of_the_registered_ids_size() -> None:
+    """The suite's floorplan levels are those of ``digslam/DigCoverageFloorplan-v0`` (the same window size,
+    :data:`digslam.envs.FLOORPLAN_WORLD_SIZE`); the procedural ones keep the default frame."""
+    from digslam.envs import COVERAGE_IDS, ENV_IDS, FLOORPLAN_WORLD_SIZE
+
+    env_id, kw = GENERATORS["floorplan"]
+    assert kw == {"world": "floorplan", "world_size": FLOORPLAN_WORLD_SIZE}
+    assert COVERAGE_IDS["digslam/DigCoverageFloorplan-v0"] == {
+        "world": "floorplan",
+        "world_size": kw["world_size"],
+    }
+    assert ENV_IDS["digslam/ExploreFloorplan-v0"] == {"world": "floorplan", "world_size": kw["world_size"]}
+    assert all("world_size" not in GENERATORS[g][1] for g in ("room", "rocks", "caves", "rooms"))
+    env = gym.make("digslam/DigCoverageFloorplan-v0")
+    assert env.unwrapped.config.world_size == FLOORPLAN_WORLD_SIZE
+    env.close()
 
 
 def test_benchmark_agents_refuses_a_bad_setting_or_generator_in_one_line() -> None:

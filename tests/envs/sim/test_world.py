@@ -165,11 +165,11 @@ def test_the_mixed_env_gives_new_levels_of_every_generator() -> None:
 def test_one_registry_names_every_world() -> None:
     """The config's world names are the registry's, and each generator builds itself from a config."""
     from digslam.envs.config import WORLDS, ExploreConfig
-    from digslam.envs.sim.generators import BENCHMARK, GENERATORS, make_generator
+    from digslam.envs.sim.generators import BENCHMARK, GENERATORS, PROCEDURAL, make_generator
 
     assert set(WORLDS) == set(GENERATORS) and set(BENCHMARK) <= set(GENERATORS)
     rocks = make_generator(ExploreConfig(world="rocks", n_obstacles=5, world_size=8.0))
     assert isinstance(rocks, RockField) and rocks.n == 5 and rocks.frame == (-8.0, -8.0, 8.0, 8.0)
     mixed = make_generator(ExploreConfig(world="mixed", n_obstacles=7, room_jitter=0.2))
-    assert isinstance(mixed, Mixed) and [g.name for g in mixed.generators] == list(BENCHMARK)
+    assert isinstance(mixed, Mixed) and [g.name for g in mixed.generators] == list(PROCEDURAL)
     assert mixed.generators[1].n == 7 and mixed.generators[0].jitter == 0.2
