@@ -90,20 +90,11 @@ def model_kwargs(model: Path) -> dict[str, Any]:
 
 
 def env_settings(items: list[str]) -> dict[str, Any]:
-    """``--set KEY=VALUE`` items as environment keywords (values parsed as TOML literals, else strings).
+    """``--set KEY=VALUE`` items as environment keywords (values parsed as TOML literals, else strings;
+    ValueError naming ``--set`` for an item without ``=``)."""
+    from digslam.observer.core.config import parse_assignment
 
-    Raises:
-        ValueError: an item without ``=``.
-    """
-    from digslam.observer.core.config import parse_value
-
-    out: dict[str, Any] = {}
-    for item in items:
-        key, sep, raw = item.partition("=")
-        if not sep or not key.strip():
-            raise ValueError(f"--set: expected KEY=VALUE, got {item!r}")
-        out[key.strip()] = parse_value(raw.strip())
-    return out
+    return dict(parse_assignment(item, "--set") for item in items)
 
 
 def chosen_baselines(agents: list[str] | None) -> list[str]:

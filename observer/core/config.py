@@ -171,6 +171,18 @@ def parse_value(raw: str) -> Any:
         return raw
 
 
+def parse_assignment(item: str, option: str = "overrides") -> tuple[str, Any]:
+    """``(key, value)`` of one ``key=value`` string, the value parsed by :func:`parse_value`.
+
+    Raises:
+        ValueError: no ``=`` or an empty key, naming ``option`` (the command-line option or argument).
+    """
+    key, sep, raw = item.partition("=")
+    if not sep or not key.strip():
+        raise ValueError(f"{option}: expected KEY=VALUE, got {item!r}")
+    return key.strip(), parse_value(raw.strip())
+
+
 def apply_overrides(data: Mapping[str, Any], overrides: Iterable[str],
                     dotted: Sequence[str] = ()) -> dict[str, Any]:  # fmt: skip
     """``data`` with ``key=value`` strings applied (values parsed by :func:`parse_value`); ``head.sub=value``
@@ -182,11 +194,7 @@ def apply_overrides(data: Mapping[str, Any], overrides: Iterable[str],
     """
     out = dict(data)
     for item in overrides:
-        key, sep, raw = item.partition("=")
-        key = key.strip()
-        if not sep or not key:
-            raise ValueError(f"overrides: expected key=value, got {item!r}")
-        value = parse_value(raw.strip())
+        key, value = parse_assignment(item)
         head, _, sub = key.partition(".")
         if head not in out:
             raise ValueError(f"{head}: unknown key; known: {sorted(out)}")
@@ -249,6 +257,7 @@ def check_choice(name: str, v: Any, choices: Iterable[Any]) -> None:
 __all__ = [
     "Config",
     "apply_overrides",
+    "parse_assignment",
     "check",
     "check_choice",
     "check_finite_nonneg",
