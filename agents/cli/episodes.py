@@ -16,17 +16,35 @@ from digslam.agents.cli.agents import resolve_agent
 from digslam.agents.cli.common import UserError, check_env_id, commit, first_line, make_env, out_path, staged
 
 
+def _log_out(out: Path, fmt: str) -> tuple[Path, Path]:
+    """The bag path for ``--format fmt`` (a ``.npz`` name loses its suffix; a ROS 1 bag ends in ``.bag``) and
+    ``bounds.toml`` beside it; neither may exist (a log is never overwritten)."""
+    if out.suffix == ".npz":
+        out = out.with_suffix("")
+    if fmt == "bag" and out.suffix != ".bag":
+        out = out.with_name(out.name + ".bag")
+    bounds = out.parent / "bounds.toml"
+    for p in (out, bounds):
+        if p.exists():
+            raise UserError(f"{p}: exists already; give another --out (a log is never overwritten)")
+    return out, bounds
+
+
 def cmd_record(args: argparse.Namespace) -> int:
-    """``digslam record``: run an agent for ``--steps`` and save the episode (``.npz``)."""
+    """``digslam record``: run an agent for ``--steps`` and save the episode (``.npz``, or with ``--format``
+    a ROS bag plus ``bounds.toml``)."""
     import numpy as np
 
     from digslam.envs.explore.episode import Episode, GroundTruth
     from digslam.observer.record.mission import MissionRecord
 
     check_env_id(args.env, "record")
+    fmt = getattr(args, "format", "npz")
     out = Path(args.out)
     out_path(out, "--out", folder=False)
-    if out.suffix != ".npz":  # numpy would add it anyway: say so by writing the name we print
+    if fmt != "npz":
+        out, bounds_path = _log_out(out, fmt)
+    elif out.suffix != ".npz":  # numpy would add it anyway: say so by writing the name we print
         out = out.with_name(out.name + ".npz")
     out = out_path(out, "--out", folder=False)
     name, policy, kwargs = resolve_agent(args.agent, args.env, args.model)
@@ -56,12 +74,32 @@ def cmd_record(args: argparse.Namespace) -> int:
                      MissionRecord.stack(recs), GroundTruth.stack(truths))  # fmt: skip
     finally:
         env.close()
-    with staged(out.parent) as tmp:
-        ep.save(tmp / out.name)
-        commit({tmp / out.name: out})
+    if fmt != "npz":
+        _write_bag(ep, out, bounds_path, fmt)
+        out = f"{out} and {bounds_path}"  # type: ignore[assignment]  # only printed below
+    else:
+        with staged(out.parent) as tmp:
+            ep.save(tmp / out.name)
+            commit({tmp / out.name: out})
     print(f"agent {name}: {len(ep.actions)} steps, certified coverage {info['certified_coverage']:.3f}; "
           f"wrote {out}")  # fmt: skip
     return 0
+
+
+def _write_bag(ep: Any, out: Path, bounds_path: Path, fmt: str) -> None:
+    """Write the episode as a ROS bag and its bounds file (:mod:`digslam.envs.sim.episode_log`)."""
+    from digslam.envs.sim.episode_log import episode_streams
+    from digslam.observer.record.bag_write import LogWriteError, write_log
+
+    streams, text = episode_streams(ep.records, ep.truth.pose, ep.config)
+    try:
+        bounds_path.parent.mkdir(parents=True, exist_ok=True)
+        with staged(bounds_path.parent) as tmp:
+            (tmp / bounds_path.name).write_text(text)
+            write_log(out, fmt, streams)
+            commit({tmp / bounds_path.name: bounds_path})
+    except LogWriteError as exc:
+        raise UserError(first_line(exc)) from None
 
 
 def same_episode(a: Any, b: Any) -> bool:

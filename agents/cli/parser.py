@@ -65,10 +65,15 @@ def build_parser() -> argparse.ArgumentParser:
     add_ray_options(p)  # --ray, --address, --ray-cpus
     p.set_defaults(func=cmd_evaluate)
 
-    p = sub.add_parser("record", help="record an agent's episode to a MissionRecord .npz")
+    p = sub.add_parser("record", help="record an agent's episode to a MissionRecord .npz or a ROS bag")
     agent_options(p, "frontier")
     p.add_argument("--steps", type=int, default=300, help="episode length (default %(default)s)")
-    p.add_argument("--out", default="out/episode.npz", help="output file (default %(default)s)")
+    p.add_argument("--out", default="out/episode.npz", help="output file (default %(default)s; with a bag "
+                   "format its .npz suffix is dropped)")  # fmt: skip
+    p.add_argument("--format", default="npz", choices=["npz", "mcap", "sqlite3", "bag"],
+                   help="npz (a MissionRecord episode, default), or a ROS bag: mcap or sqlite3 (ROS 2 "
+                   "bag folder), bag (ROS 1); a bag comes with bounds.toml beside it, matching the env's "
+                   "noise")  # fmt: skip
     p.add_argument("--no-progress", dest="progress", action="store_false", help="hide the progress bar")
     p.set_defaults(func=cmd_record)
 
