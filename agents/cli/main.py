@@ -1,4 +1,4 @@
-"""The ``digslam`` command: demo, train, evaluate, record, replay, sweep, warmup and benchmark.
+"""The ``digslam`` command: demo, train, evaluate, record, replay, sweep, certify, warmup and benchmark.
 
 ``digslam demo`` runs ``digslam/DigCoverage-v0`` with the best agent of the leaderboard shipped in
 ``digslam/agents/data/leaderboard.json`` (``--agent best``, the default; it prints which agent that is and
@@ -25,6 +25,7 @@ import warnings
 from typing import Any
 
 from digslam.agents.cli.agents import agent_names, load_agent, load_ppo, model_env_kwargs, resolve_agent
+from digslam.agents.cli.certify import cmd_certify
 from digslam.agents.cli.commands import (
     benchmarks_dir,
     cmd_benchmark,
@@ -109,6 +110,7 @@ __all__ = [
     "build_parser",
     "check_env_id",
     "cmd_benchmark",
+    "cmd_certify",
     "cmd_demo",
     "cmd_evaluate",
     "cmd_record",

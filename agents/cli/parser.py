@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 
+from digslam.agents.cli.certify import add_certify_parser
 from digslam.agents.cli.commands import cmd_benchmark, cmd_demo, cmd_evaluate, cmd_train, cmd_warmup
 from digslam.agents.cli.distributed import add_ray_options, add_sweep_parser
 from digslam.agents.cli.episodes import cmd_record, cmd_replay
@@ -85,6 +86,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_replay)
 
     add_sweep_parser(sub)  # sweep CONFIG [--address A] [--resume] [--num-cpus N]
+    add_certify_parser(sub)  # certify LOG --bounds B.toml --out DIR
 
     p = sub.add_parser(
         "warmup",
