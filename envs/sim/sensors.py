@@ -63,6 +63,7 @@ class SensorSuite:
         _k_gamma: np.ndarray = field(init=False)
         _k_r_max: np.ndarray = field(init=False)
         _k_cones: np.ndarray = field(init=False)
+        _centred: np.ndarray = field(init=False)
         _model: tuple[Any, ...] = field(init=False)
 
     def __post_init__(self) -> None:
@@ -83,6 +84,9 @@ class SensorSuite:
         for name in ("alpha", "gamma", "r_max"):
             object.__setattr__(self, "_k_" + name, getattr(self, name).copy())
         object.__setattr__(self, "_k_cones", np.stack([self.alpha, self.gamma, self.r_max]))  # sense()
+        centred = np.zeros((self.n, 2))  # every record's mount and slack: cones at the centre, read at t
+        centred.flags.writeable = False
+        object.__setattr__(self, "_centred", centred)
         # record_step's cache per noise configuration: (noise, tol, r_max, the RecordModel's scalars, whether
         # outliers are drawn)
         object.__setattr__(self, "_model", (None, None, None, None, False))
@@ -237,6 +241,8 @@ def _record(
         "outlier": flag,
         "lateral": out[-3],
         "mean_velocity": out[-2:],
+        "mount": suite._centred,
+        "slack": suite._centred,
     }
     return rec
 

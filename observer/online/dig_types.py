@@ -19,7 +19,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["NO_MEAN", "CellAxes", "CellSets", "GridFrame", "PoseBox", "SectorBatch", "StepRecord"]
+__all__ = ["NO_MEAN", "NO_MOUNT", "CellAxes", "CellSets", "GridFrame", "PoseBox", "SectorBatch", "StepRecord"]
 
 
 class GridFrame(NamedTuple):
@@ -122,6 +122,9 @@ class SectorBatch(NamedTuple):
 #: The mean velocity of a record that does not measure it (``MissionRecord``'s default): never written.
 NO_MEAN = np.array([[-math.inf, math.inf], [-math.inf, math.inf]])
 NO_MEAN.flags.writeable = False
+#: :attr:`StepRecord.mount` and :attr:`StepRecord.slack` of a step whose cones are all centred: no rows.
+NO_MOUNT = np.zeros((0, 2))
+NO_MOUNT.flags.writeable = False
 
 
 class StepRecord(NamedTuple):
@@ -140,6 +143,8 @@ class StepRecord(NamedTuple):
         no_echo: ``(n,)`` bool, True where nothing lies in the cone up to ``r_max``.
         mean_velocity: ``(2, 2)`` the body-frame velocity averaged over the step (rows ``v̄_1``, ``v̄_2``;
             ``[-inf, inf]`` twice when not measured, the default).
+        mount, slack: ``(n, 2)`` each cone's place on the robot and its reading's slack
+            (:mod:`.mount_jit`); the default, no rows (:data:`NO_MOUNT`), is every cone centred.
     """
 
     dt: float
@@ -153,3 +158,5 @@ class StepRecord(NamedTuple):
     ranges: np.ndarray
     no_echo: np.ndarray
     mean_velocity: np.ndarray = NO_MEAN
+    mount: np.ndarray = NO_MOUNT
+    slack: np.ndarray = NO_MOUNT

@@ -44,6 +44,7 @@ from digslam.observer.online.dig_jit import (
     union,
 )
 from digslam.observer.online.dig_types import CellAxes, CellSets, GridFrame, PoseBox, StepRecord
+from digslam.observer.online.mount_jit import apex, mount_kind
 
 __all__ = ["mark_cells", "mark_batch", "dig_and_mark", "dig_and_mark_q"]
 
@@ -155,6 +156,36 @@ def _settle(cells: CellSets, need: int) -> tuple[int, int, int, int]:
 
 
 @njit
+def _dig_and_mark_each(cells: CellSets, grid: GridFrame, box: PoseBox, step: StepRecord, mark: bool, q: int
+                       ) -> tuple[int, int, int, int]:  # fmt: skip
+    """:func:`dig_and_mark_q` for readings of different mounts or slacks: each reading digs (counts, with
+    ``q > 0``) and marks from its own apex box (:func:`.mount_jit.apex`), on its own row and column bounds."""
+    alpha, gamma, r_max, rng = step.alpha, step.gamma, step.r_max, step.ranges
+    w = (0, 0, 0, 0)
+    dug = (0, 0, 0, 0)
+    n = alpha.size
+    for k in range(n):
+        b = apex(box, step.mount[k, 0], step.mount[k, 1], step.slack[k, 0], step.slack[k, 1])
+        r_dig = min(rng[k, 0], r_max[k])
+        rm = min(rng[k, 1], r_max[k]) if q == 0 else r_max[k]
+        reach = 0.0
+        for r in (r_dig, rm):
+            if math.isfinite(r):
+                reach = max(reach, r)
+        axes = reach_axes(grid, b, reach)
+        if q == 0:
+            w = union(w, dig_reading(cells, grid, b, alpha[k], gamma[k], r_dig, gamma[k] >= PI_DOWN, axes, 0))
+        elif n > q:
+            dug = union(dug, dig_reading(cells, grid, b, alpha[k], gamma[k], r_dig, gamma[k] >= PI_DOWN, axes,
+                                         k + 1))  # fmt: skip
+        if mark:
+            w = union(w, _mark(cells.maybe, grid, b, alpha[k], gamma[k], rm, axes))
+    if q > 0 and dug[0] < dug[1] and dug[2] < dug[3]:
+        w = union(w, _settle(cells, q + 1))
+    return w
+
+
+@njit
 def dig_and_mark_q(cells: CellSets, grid: GridFrame, box: PoseBox, step: StepRecord, mark: bool, q: int
                    ) -> tuple[int, int, int, int]:  # fmt: skip
     """:func:`dig_and_mark` robust to at most ``q`` outliers among the ``n`` readings of this step.
@@ -169,9 +200,17 @@ def dig_and_mark_q(cells: CellSets, grid: GridFrame, box: PoseBox, step: StepRec
     is free and was sensed. With ``q >= n`` nothing is dug. An outlier's upper range can be below the truth,
     so ``Z⁺`` is grown with ``r_max`` for every reading: the union over all the choices of at most
     ``q >= 1`` outliers (a true echo is within ``r_max``).
+
+    Mounted cones and readings with a slack (:mod:`.mount_jit`) dig and mark from their apex box: one for
+    the step when they share a mount and slack, else each its own (:func:`_dig_and_mark_each`).
     """
     if not box_ok(box):
         return 0, 0, 0, 0
+    kind = mount_kind(step.mount, step.slack)
+    if kind == 2:
+        return _dig_and_mark_each(cells, grid, box, step, mark, q)
+    if kind == 1:  # one apex box for every reading (:mod:`.mount_jit`)
+        box = apex(box, step.mount[0, 0], step.mount[0, 1], step.slack[0, 0], step.slack[0, 1])
     alpha, gamma, r_max, rng = step.alpha, step.gamma, step.r_max, step.ranges
     reach = 0.0
     for k in range(alpha.size):

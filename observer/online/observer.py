@@ -145,11 +145,13 @@ def band_of(psi: np.ndarray) -> tuple[float, float]:
 def _step_record(rec: MissionRecord, dt: float) -> StepRecord:
     """The kernels' view of a single-step record (:class:`.dig_types.StepRecord`): its arrays, not copied
     (``lateral`` unset, as in a record built without ``MissionRecord.__init__``: ``[0, 0]``, a unicycle;
-    ``mean_velocity`` unset: not measured)."""
+    ``mean_velocity`` unset: not measured; ``mount`` and ``slack`` unset: centred cones)."""
     lat = rec.lateral if rec.lateral is not None else _NO_SLIP
     mean = rec.mean_velocity if rec.mean_velocity is not None else NO_MEAN
+    mount = rec.mount if rec.mount is not None else np.zeros((rec.alpha.shape[0], 2))
+    slack = rec.slack if rec.slack is not None else np.zeros((rec.alpha.shape[0], 2))
     return StepRecord(dt, rec.speed, lat, rec.yaw_rate, rec.heading, rec.alpha, rec.gamma, rec.r_max,
-                      rec.range, rec.no_echo, mean)  # fmt: skip
+                      rec.range, rec.no_echo, mean, mount, slack)  # fmt: skip
 
 
 class OnlineDigSlam:
@@ -258,10 +260,8 @@ class OnlineDigSlam:
             return
         start = time.perf_counter()
         # the kernels' StepRecord as a plain tuple of its fields (not copied): see filter_step_flat
-        lat = rec.lateral if rec.lateral is not None else _NO_SLIP
-        mean = rec.mean_velocity if rec.mean_velocity is not None else NO_MEAN
-        step = (dt, rec.speed, lat, rec.yaw_rate, rec.heading, rec.alpha, rec.gamma, rec.r_max, rec.range,
-                rec.no_echo, mean)  # fmt: skip
+        record = _step_record(rec, dt)
+        step = tuple(record)
         # the kernel overwrites copies of the state: the arrays handed out are never changed
         lo, hi, psi = self.pose_lo.copy(), self.pose_hi.copy(), np.array((self.heading_lo, self.heading_hi))
         impacts = self._impacts
@@ -277,7 +277,7 @@ class OnlineDigSlam:
             self._touch(r0, r1, c0, c1)
         if self._window:
             band = (self.heading_lo, self.heading_hi)
-            self._ring.append([StepRecord(*step), self.pose_lo.copy(), self.pose_hi.copy(), band, d])
+            self._ring.append([record, self.pose_lo.copy(), self.pose_hi.copy(), band, d])
         self._prev, self._t_prev = rec, t
         self.steps += 1
         if self._window and not self._smooth():

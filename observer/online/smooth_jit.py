@@ -30,12 +30,9 @@ from typing import NamedTuple
 import numpy as np
 
 from digslam.observer.core.scalar_jit import add_dn, add_up, njit, sub_dn, sub_up
-from digslam.observer.online.cones_jit import contract_cones
-from digslam.observer.online.dig_jit import in_frame
 from digslam.observer.online.dig_types import CellSets, GridFrame, PoseBox, StepRecord
 from digslam.observer.online.mark_jit import dig_and_mark_q
-from digslam.observer.online.pose_jit import contract, impact_bound_q
-from digslam.observer.online.step_jit import CONE_MIN_WIDTH, filter_step_q
+from digslam.observer.online.step_jit import contract_step, filter_step_q
 from digslam.observer.record.mission import MissionRecord
 
 __all__ = [
@@ -68,6 +65,8 @@ class RecordArrays(NamedTuple):
     ranges: np.ndarray  # (T + 1, n, 2)
     no_echo: np.ndarray
     mean_velocity: np.ndarray  # (T + 1, 2, 2)
+    mount: np.ndarray  # (T + 1, n, 2), then slack
+    slack: np.ndarray
 
 
 def record_arrays(rec: MissionRecord) -> RecordArrays:
@@ -75,7 +74,7 @@ def record_arrays(rec: MissionRecord) -> RecordArrays:
     f = np.ascontiguousarray
     return RecordArrays(f(rec.t, np.float64), f(rec.speed), f(rec.lateral), f(rec.yaw_rate), f(rec.heading),
                         f(rec.alpha), f(rec.gamma), f(rec.r_max), f(rec.range), f(rec.no_echo, np.bool_),
-                        f(rec.mean_velocity))  # fmt: skip
+                        f(rec.mean_velocity), f(rec.mount), f(rec.slack))  # fmt: skip
 
 
 @njit
@@ -85,7 +84,7 @@ def step_at(rec: RecordArrays, k: int) -> StepRecord:
     dt = rec.t[k] - rec.t[k - 1] if k > 0 else 0.0
     return StepRecord(dt, rec.speed[k], rec.lateral[k], rec.yaw_rate[k], rec.heading[k], rec.alpha[k],
                       rec.gamma[k], rec.r_max[k], rec.ranges[k], rec.no_echo[k],
-                      rec.mean_velocity[k])  # fmt: skip
+                      rec.mean_velocity[k], rec.mount[k], rec.slack[k])  # fmt: skip
 
 
 @njit
@@ -161,14 +160,8 @@ def contract_gates(free: np.ndarray, grid: GridFrame, rec: RecordArrays, lo: np.
     """
     for j in range(k0, k1 + 1):
         step = step_at(rec, j)
-        x0, y0, x1, y1 = lo[j, 0], lo[j, 1], hi[j, 0], hi[j, 1]
-        r_hi = impact_bound_q(step.no_echo, step.ranges, q)
-        if math.isfinite(r_hi) and in_frame(grid, x0, y0, x1, y1):
-            if impacts <= 2:
-                x0, y0, x1, y1 = contract(free, grid, x0, y0, x1, y1, r_hi)
-            if impacts >= 2 and x0 <= x1 and y0 <= y1 and max(x1 - x0, y1 - y0) > CONE_MIN_WIDTH:
-                x0, y0, x1, y1 = contract_cones(free, grid, x0, y0, x1, y1, psi[j, 0], psi[j, 1], step.alpha,
-                                                step.gamma, step.ranges, step.no_echo, q)  # fmt: skip
+        x0, y0, x1, y1 = contract_step(free, grid, step, lo[j, 0], lo[j, 1], hi[j, 0], hi[j, 1], psi[j, 0],
+                                       psi[j, 1], impacts, q)  # fmt: skip
         if not (x0 <= x1 and y0 <= y1):
             return j
         lo[j, 0], lo[j, 1], hi[j, 0], hi[j, 1] = x0, y0, x1, y1

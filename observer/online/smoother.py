@@ -40,7 +40,10 @@ loop (12,001 samples) less than Algorithm 6.3 as written,
 The data contract is :mod:`digslam.observer.record.mission`'s: ``speed[k]``, ``lateral[k]`` and
 ``yaw_rate[k]`` bound the truth over the slice ``[t_{k-1}, t_k]`` that ends at ``t_k``; ``heading[k]`` bounds
 the heading at ``t_k``; ``range[k]`` bounds the ranges from the pose at ``t_k``; ``mean_velocity[k]`` bounds
-the velocity averaged over the slice in the body frame at its start.
+the velocity averaged over the slice in the body frame at its start. A mounted sensor's ranges are from its
+cone's apex, and a reading with a slack was taken within it of the record's pose (``mount``, ``slack``): the
+kernels then dig, mark and contract from the apex box (:mod:`.mount_jit`), and step 3's impact contractor runs
+box by box (:func:`.smooth_jit.contract_gates`) instead of on one clearance map.
 
 >>> from digslam.observer.record.mission import MissionRecord
 >>> k, one = np.arange(21), np.ones((21, 1))
@@ -136,6 +139,12 @@ def dig_slam(
     t, n, q = record.t, len(record), int(cfg.q)
     if cfg.explored and q:
         raise ValueError("config: explored=True (the App. B proofs) trusts every reading; it needs q = 0")
+    centred = record.centred
+    if cfg.explored and not centred:
+        raise ValueError(
+            "config: explored=True (the App. B proofs) takes centred cones read at the record's "
+            "instant; this record has mounts or slacks: leave explored unset"
+        )
     heading = heading_from_compass(t, record.heading[:, 0], record.heading[:, 1],
                                    record.yaw_rate[1:, 0], record.yaw_rate[1:, 1])  # fmt: skip
     if heading.is_empty():  # compass and gyro contradict each other
@@ -169,7 +178,9 @@ def dig_slam(
         before = width_inf(lo, hi)
         res.iterations = it + 1
         empty = sweep(lo, hi, d, 0, n - 1)
-        if empty < 0 and impacts:
+        if empty < 0 and impacts and not centred:  # mounted cones: each box by the step's kernels
+            empty = contract_gates(cells.free, dig.frame, rec, lo, hi, psi, impacts, q, 0, n - 1)
+        elif empty < 0 and impacts:
             lo[:], hi[:] = dig.contract_impacts(lo, hi, r_hi)  # Eq. 6.22 on every box, one clearance map
             bad = ~np.all(lo <= hi, axis=1)
             empty = int(np.argmax(bad)) if bad.any() else -1

@@ -54,13 +54,67 @@ from digslam.observer.online.cones_jit import contract_cones
 from digslam.observer.online.dig_jit import in_frame
 from digslam.observer.online.dig_types import CellSets, GridFrame, PoseBox, StepRecord
 from digslam.observer.online.mark_jit import dig_and_mark_q
+from digslam.observer.online.mount_jit import apex, centre_of, centre_ranges, mount_kind
 from digslam.observer.online.pose_jit import contract, impact_bound_q, predict
 
-__all__ = ["CONE_MIN_WIDTH", "filter_step", "filter_step_flat", "filter_step_q"]
+__all__ = ["CONE_MIN_WIDTH", "contract_step", "filter_step", "filter_step_flat", "filter_step_q"]
 
 #: Pose boxes at most this wide (m) skip the cone contractor (it seldom cuts them: ``M⁻`` is set back from
 #: the walls by about a cell); skipping a contractor never makes a claim false.
 CONE_MIN_WIDTH = 0.15
+
+
+@njit
+def _contract_centred(free: np.ndarray, grid: GridFrame, step: StepRecord, ranges: np.ndarray, x0: float,
+                      y0: float, x1: float, y1: float, psi_lo: float, psi_hi: float, impacts: int, q: int,
+                      cones: bool) -> tuple[float, float, float, float]:  # fmt: skip
+    """The impact contractor (``impacts`` 1 or 2, Eq. 6.22, q-relaxed radius from ``ranges``) then, with
+    ``cones`` and ``impacts >= 2``, the cones on a box wider than :data:`CONE_MIN_WIDTH`, for cones whose
+    apex is the box ``[x0, x1] × [y0, y1]`` (``impacts = 3``: the cones alone)."""
+    r_hi = impact_bound_q(step.no_echo, ranges, q)
+    if math.isfinite(r_hi) and in_frame(grid, x0, y0, x1, y1):
+        if impacts <= 2:
+            x0, y0, x1, y1 = contract(free, grid, x0, y0, x1, y1, r_hi)
+        if cones and impacts >= 2 and x0 <= x1 and y0 <= y1 and max(x1 - x0, y1 - y0) > CONE_MIN_WIDTH:
+            x0, y0, x1, y1 = contract_cones(free, grid, x0, y0, x1, y1, psi_lo, psi_hi, step.alpha,
+                                            step.gamma, ranges, step.no_echo, q)  # fmt: skip
+    return x0, y0, x1, y1
+
+
+@njit
+def contract_step(free: np.ndarray, grid: GridFrame, step: StepRecord, x0: float, y0: float, x1: float,
+                  y1: float, psi_lo: float, psi_hi: float, impacts: int, q: int
+                  ) -> tuple[float, float, float, float]:  # fmt: skip
+    """The contractors of one step's readings on the position box ``[x0, x1] × [y0, y1]`` (heading
+    ``[psi_lo, psi_hi]``) against ``free`` (``M⁻``): ``impacts`` 1, the impact contractor (Eq. 6.22,
+    q-relaxed radius :func:`.pose_jit.impact_bound_q`), skipped when the box leaves the grid's frame or no
+    sensor echoed; 2, also each echo's cone meeting ``comp M⁻`` (:func:`.cones_jit.contract_cones`) on a box
+    wider than :data:`CONE_MIN_WIDTH`; 3, the cones alone.
+
+    Mounted cones (:mod:`.mount_jit`): sharing one mount and slack, both act on the apex box and the position
+    is cut to what the contracted apex box allows (:func:`.mount_jit.centre_of`); mixed, the impact radius
+    of each reading is widened to the position (:func:`.mount_jit.centre_ranges`) and the cones are
+    skipped (skipping a contractor never makes a claim false).
+
+    Returns:
+        The contracted box; empty (``x0 > x1`` or ``y0 > y1``) when no position meets the readings.
+    """
+    kind = mount_kind(step.mount, step.slack)
+    if kind == 0:
+        return _contract_centred(free, grid, step, step.ranges, x0, y0, x1, y1, psi_lo, psi_hi, impacts, q,
+                                 True)  # fmt: skip
+    if kind == 2:
+        if impacts == 3:
+            return x0, y0, x1, y1
+        wide = centre_ranges(step.ranges, step.mount, step.slack)
+        return _contract_centred(free, grid, step, wide, x0, y0, x1, y1, psi_lo, psi_hi, impacts, q, False)
+    m1, m2, sp = step.mount[0, 0], step.mount[0, 1], step.slack[0, 0]
+    a = apex(PoseBox(x0, y0, x1, y1, psi_lo, psi_hi), m1, m2, sp, step.slack[0, 1])
+    a0, b0, a1, b1 = _contract_centred(free, grid, step, step.ranges, a.x_lo, a.y_lo, a.x_hi, a.y_hi,
+                                       a.psi_lo, a.psi_hi, impacts, q, True)  # fmt: skip
+    if not (a0 <= a1 and b0 <= b1):
+        return a0, b0, a1, b1
+    return centre_of(x0, y0, x1, y1, PoseBox(a0, b0, a1, b1, a.psi_lo, a.psi_hi), m1, m2, sp)
 
 
 @njit
@@ -96,13 +150,8 @@ def filter_step_q(cells: CellSets, grid: GridFrame, step: StepRecord, pose_lo: n
         return 1, 0, 0, 0, 0, nan
     x0, y0, x1, y1 = box.x_lo, box.y_lo, box.x_hi, box.y_hi
     if impacts:
-        r_hi = impact_bound_q(step.no_echo, step.ranges, q)
-        if math.isfinite(r_hi) and in_frame(grid, x0, y0, x1, y1):
-            x0, y0, x1, y1 = contract(cells.free, grid, x0, y0, x1, y1, r_hi)
-            if impacts >= 2 and x0 <= x1 and y0 <= y1 and max(x1 - x0, y1 - y0) > CONE_MIN_WIDTH:
-                x0, y0, x1, y1 = contract_cones(cells.free, grid, x0, y0, x1, y1, box.psi_lo,
-                                                box.psi_hi, step.alpha, step.gamma, step.ranges,
-                                                step.no_echo, q)  # fmt: skip
+        x0, y0, x1, y1 = contract_step(cells.free, grid, step, x0, y0, x1, y1, box.psi_lo, box.psi_hi,
+                                       impacts, q)  # fmt: skip
     if not (x0 <= x1 and y0 <= y1):
         return 1, 0, 0, 0, 0, nan
     lo[0], lo[1], hi[0], hi[1] = x0, y0, x1, y1

@@ -43,9 +43,9 @@ import numpy as np
 
 _PREFIX = "record_"
 _FLOAT_FIELDS = ("t", "speed", "yaw_rate", "heading", "alpha", "gamma", "r_max", "range", "lateral",
-                 "mean_velocity")  # fmt: skip
+                 "mean_velocity", "mount", "slack")  # fmt: skip
 #: Fields that default when absent (records saved before they existed).
-_OPTIONAL = ("lateral", "mean_velocity")
+_OPTIONAL = ("lateral", "mean_velocity", "mount", "slack")
 #: ``mean_velocity`` of a record that does not measure it: the whole line for ``v_1`` and ``v_2``.
 UNMEASURED = np.array([[-np.inf, np.inf], [-np.inf, np.inf]])
 UNMEASURED.flags.writeable = False
@@ -71,6 +71,14 @@ class MissionRecord:
         mean_velocity: The odometry increment: the velocity averaged over the slice that ends at the record,
             in the body frame at the slice's start (m/s), shape ``(..., 2, 2)`` (rows forward, leftward;
             columns ``lo``, ``hi``); default :data:`UNMEASURED`.
+        mount: Where each range sensor sits on the robot, in the body frame (m), shape ``(..., n, 2)``
+            (forward, leftward); default zeros (every cone's apex at the robot's centre). A reading's cone
+            has its apex at ``x + R(psi) mount`` and its ranges are distances from that apex.
+        slack: How far each reading's own instant may be from the record's, shape ``(..., n, 2)``: the
+            pose when the reading was taken lies within ``slack[..., 0]`` (m, on each axis) of the
+            record's position and ``slack[..., 1]`` (rad) of its heading; default zeros (the reading is
+            taken at ``t``). A log's reader sets it from the gap between the reading's stamp and the
+            record's, times the premise's speed and yaw-rate limits.
     """
 
     t: np.ndarray
@@ -85,6 +93,8 @@ class MissionRecord:
     outlier: np.ndarray
     lateral: np.ndarray = None  # type: ignore[assignment]  # None: [0, 0] (set in __post_init__)
     mean_velocity: np.ndarray = None  # type: ignore[assignment]  # None: UNMEASURED (set in __post_init__)
+    mount: np.ndarray = None  # type: ignore[assignment]  # None: zeros (set in __post_init__)
+    slack: np.ndarray = None  # type: ignore[assignment]  # None: zeros (set in __post_init__)
 
     def __post_init__(self) -> None:
         d = self.__dict__
@@ -92,6 +102,9 @@ class MissionRecord:
             d["lateral"] = np.zeros(np.shape(d["speed"]))
         if d["mean_velocity"] is None:
             d["mean_velocity"] = np.broadcast_to(UNMEASURED, np.shape(d["t"]) + (2, 2)).copy()
+        for name in ("mount", "slack"):
+            if d[name] is None:
+                d[name] = np.zeros(np.shape(d["alpha"]) + (2,))
         for name in _FLOAT_FIELDS:
             d[name] = np.asarray(d[name], dtype=np.float64)
         d["no_echo"] = np.asarray(d["no_echo"], dtype=bool)
@@ -110,6 +123,9 @@ class MissionRecord:
             raise ValueError(f"range: expected shape {lead + n + (2,)}, got {self.range.shape}")
         if self.mean_velocity.shape != lead + (2, 2):
             raise ValueError(f"mean_velocity: expected shape {lead + (2, 2)}, got {self.mean_velocity.shape}")
+        for name in ("mount", "slack"):
+            if getattr(self, name).shape != lead + n + (2,):
+                raise ValueError(f"{name}: expected shape {lead + n + (2,)}, got {getattr(self, name).shape}")
         self._check_bounds()
 
     def _check_bounds(self) -> None:
@@ -126,11 +142,21 @@ class MissionRecord:
             raise ValueError("gamma: cone half-apertures must be in (0, pi]")
         if np.any(~(self.r_max > 0) | ~np.isfinite(self.r_max)):
             raise ValueError("r_max: maximum ranges must be finite and > 0")
+        if not np.all(np.isfinite(self.mount)):
+            raise ValueError("mount: sensor positions must be finite")
+        if np.any(~(self.slack >= 0) | ~np.isfinite(self.slack)):
+            raise ValueError("slack: reading slacks must be finite and >= 0")
 
     @property
     def n_sensors(self) -> int:
         """Number of range sensors (cones, omni included)."""
         return int(self.alpha.shape[-1])
+
+    @property
+    def centred(self) -> bool:
+        """Whether every reading is taken from the robot's centre at the record's instant (``mount`` and
+        ``slack`` all zero): the observers then use their centred kernels unchanged."""
+        return not (np.any(self.mount) or np.any(self.slack))
 
     def __len__(self) -> int:
         if self.t.ndim == 0:
@@ -176,9 +202,9 @@ class MissionRecord:
     def from_arrays(
         arrays: dict[str, np.ndarray] | np.lib.npyio.NpzFile, prefix: str = _PREFIX
     ) -> MissionRecord:
-        """Inverse of :meth:`to_arrays`; raises ``KeyError`` naming a missing field (``lateral`` and
-        ``mean_velocity``, absent from records saved before they existed, default to ``[0, 0]`` and
-        :data:`UNMEASURED`)."""
+        """Inverse of :meth:`to_arrays`; raises ``KeyError`` naming a missing field (``lateral``,
+        ``mean_velocity``, ``mount`` and ``slack``, absent from records saved before they existed, default to
+        ``[0, 0]``, :data:`UNMEASURED` and zeros)."""
         out = {}
         for f in fields(MissionRecord):
             key = prefix + f.name

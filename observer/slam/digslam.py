@@ -145,8 +145,11 @@ def explored_zone(grid: Grid, record: MissionRecord, tube: Tube, heading: Tube) 
     radius ``y⁻`` for every pose and heading (:meth:`DigMap.dig_sectors`), dark where it is proved outside
     the disk of radius ``y⁺`` around every pose, unknown elsewhere (the full sector tests of
     :func:`.explored_sweep.explored_sectors_grid` prove penumbra too but cost far more per reading).
-    The sensors' zones are joined by :func:`explored_union`.
+    The sensors' zones are joined by :func:`explored_union`. The cones must be centred and read at the
+    record's instant (``record.centred``).
     """
+    if not record.centred:
+        raise ValueError("record: the explored-zone proofs take centred cones read at the record's instant")
     lo_r = record.range[..., 0]
     hi_r = np.where(record.no_echo, record.r_max, record.range[..., 1])
     parts = []
@@ -247,6 +250,9 @@ def thesis_dig_slam(
         raise ValueError("config: thesis_dig_slam has no q-relaxed mode (q must be 0); use dig_slam")
     if record.t.ndim != 1 or len(record) < 2:
         raise ValueError("record: expected a stacked mission of at least two samples")
+    if not record.centred:
+        raise ValueError("record: thesis_dig_slam takes centred cones read at the record's instant (mount "
+                         "and slack zero); use dig_slam for mounted sensors")
     x0_lo, x0_hi = np.asarray(x0_lo, dtype=np.float64), np.asarray(x0_hi, dtype=np.float64)
     if x0_lo.shape != (2,) or x0_hi.shape != (2,) or np.any(x0_lo > x0_hi) or np.isnan(x0_lo + x0_hi).any():
         raise ValueError(f"x0_lo, x0_hi: expected a 2-d box, got {x0_lo} and {x0_hi}")
