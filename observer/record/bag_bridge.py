@@ -8,7 +8,8 @@ records, each interval rounded outward so that it holds every value the bounds f
   message is attached to the last odometry message at or before its stamp; one before the first or after the
   last odometry message is dropped (``dropped["outside_odometry"]``). When several messages of one topic
   attach to one odometry message, the record holds them all (that topic's slots repeat, padded with "no
-  reading" slots ``[0, inf]``), and ``q`` counts per message: ``Log.q = sum(q · most messages per record)``.
+  reading" slots ``[0, inf]``), and ``q`` counts per message: ``Log.q = sum(q · most messages per record)``,
+  twice for a scan kept with its merged readings (an outlier beam spoils its slot and its group's).
 - **Odometry.** Odometry message ``i`` claims its interval over its own slice ``[t_{i-1}, t_i]``; a record's
   ``speed``, ``lateral`` and ``yaw_rate`` are the hull over the slices it spans (sound: each holds the truth
   on its part). ``source = "pose"``: the values are the pose increment, ``R(-psi_mid) (p_i - p_{i-1}) / dt``
@@ -25,7 +26,9 @@ records, each interval rounded outward so that it holds every value the bounds f
   ``min(r_max, lo(v))``; any other ``v`` is an echo. A float32 value ``v`` stands for a float64 in
   ``[v⁻, v⁺]`` (its neighbouring float32s), so the interval is ``[v⁻ - b, v⁺ + b]``, ``b = abs + rel·|v⁺|``.
   ``slack`` is ``(gap·max_speed, gap·max_yaw_rate)``, ``gap`` between the beam's instant (``stamp +
-  i·time_increment``) and the record's, rounded up.
+  i·time_increment``) and the record's, rounded up. With ``beams`` below a scan's count, the kept beams are
+  evenly spread; when the scan's beams were taken at one instant and tile its field of view, the scan's
+  free space between them is kept too, as ``beams`` merged readings (:mod:`.scan_merge`).
 - **Heading.** With a compass: each record takes the nearest compass message (either side), ``yaw ±
   (bound + max_yaw_rate·gap)``. Yaw is unwrapped across messages (unique while ``max_yaw_rate·dt + 2·bound <
   pi`` between neighbours, else an error), on the branch nearest the ``[start]`` heading's centre when given.
@@ -44,6 +47,7 @@ import numpy as np
 from .bag_messages import RangeMsg
 from .bounds import Bound, Bounds, RangeBounds
 from .mission import UNMEASURED, MissionRecord
+from .scan_merge import can_merge, merge_beams
 
 _EPS = np.finfo(np.float64).eps
 
@@ -138,19 +142,35 @@ def _odometry(b: Bounds, ns: np.ndarray, pose: np.ndarray, twist: np.ndarray) ->
     return out[0], out[1], out[2], mean
 
 
+def _width(s: Sensor, msg: RangeMsg) -> int:
+    """How many slots one message of ``s`` fills: every beam, the ``beams`` kept, or those and as many
+    merged readings when the scan's beams can be merged (:func:`.scan_merge.can_merge`)."""
+    n, beams = len(msg.ranges), s.spec.beams
+    if beams is None or beams >= n:
+        return n
+    gamma = s.spec.aperture if s.spec.aperture is not None else msg.gamma
+    kept = len(np.unique(np.round(np.linspace(0, n - 1, beams)).astype(np.int64)))
+    return 2 * kept if can_merge(msg.angle_increment, gamma, msg.time_increment) else kept
+
+
 def _slots(
     s: Sensor, msg: RangeMsg, t_rec: int, b: Bounds, dropped: dict[str, int]
 ) -> tuple[np.ndarray, ...]:
     """One message's kept beams: alpha, gamma, r_max, range (n, 2), no_echo, slack (n, 2)."""
     spec, n = s.spec, len(msg.ranges)
     idx = np.arange(n)
+    gamma = spec.aperture if spec.aperture is not None else msg.gamma
+    merge = spec.beams is not None and spec.beams < n and can_merge(msg.angle_increment, gamma,
+                                                                    msg.time_increment)  # fmt: skip
     if spec.beams is not None and spec.beams < n:
         idx = np.unique(np.round(np.linspace(0, n - 1, spec.beams)).astype(np.int64))
+    keep = idx
+    if merge:  # every beam read, then the kept ones and the scan merged (.scan_merge)
+        idx = np.arange(n)
     sensor_max = msg.range_max if math.isfinite(msg.range_max) and msg.range_max > 0 else math.inf
     eff = min(spec.max_range if spec.max_range is not None else math.inf, sensor_max)
     if not math.isfinite(eff):
         raise ValueError(f"{spec.topic}: the message's range_max is {msg.range_max}: set max_range")
-    gamma = spec.aperture if spec.aperture is not None else msg.gamma
     if not 0 < gamma <= math.pi:
         raise ValueError(f"{spec.topic}: a beam's half-aperture is {gamma}: set aperture in (0, pi]")
     v32 = msg.ranges[idx]
@@ -178,7 +198,18 @@ def _slots(
     gap = np.abs((msg.ns - t_rec) * 1e-9 + idx * msg.time_increment) * (1 + 4 * _EPS)
     slack = np.stack([_up(gap * b.odometry.max_speed), _up(gap * b.odometry.max_yaw_rate)], axis=1)
     alpha = s.mount[2] + msg.angle_min + idx * msg.angle_increment
-    return alpha, np.full(len(idx), gamma), r_max, rng, no_echo, slack
+    if not merge:
+        return alpha, np.full(len(idx), gamma), r_max, rng, no_echo, slack
+    reading = echo | no_echo
+    m_a, m_g, m_r, m_y, m_ne = merge_beams(alpha, gamma, rng, no_echo, r_max, reading, len(keep))
+    return (
+        np.concatenate([alpha[keep], m_a]),
+        np.concatenate([np.full(len(keep), gamma), m_g]),
+        np.concatenate([r_max[keep], m_r]),
+        np.concatenate([rng[keep], m_y]),
+        np.concatenate([no_echo[keep], m_ne]),
+        np.concatenate([slack[keep], slack[keep[: len(m_a)]]]),
+    )
 
 
 def _heading(b: Bounds, t: np.ndarray, compass: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
@@ -215,9 +246,7 @@ def assemble(b: Bounds, ns: np.ndarray, pose: np.ndarray, twist: np.ndarray,
     rec = np.array(sorted({0}.union(*[g.keys() for g in groups])), dtype=np.int64)
     K, t_rec = len(rec), ns[rec]
     # slots: sensor s has `per` messages of `width` beams per record
-    widths = [
-        max([min(len(m.ranges), s.spec.beams or len(m.ranges)) for m in s.msgs] or [1]) for s in sensors
-    ]
+    widths = [max([_width(s, m) for m in s.msgs] or [1]) for s in sensors]
     pers = [max([len(v) for v in g.values()] or [1]) for g in groups]
     N = sum(w * p for w, p in zip(widths, pers))
     alpha, gamma, r_max = np.zeros((K, N)), np.full((K, N), math.pi), np.ones((K, N))
@@ -275,7 +304,9 @@ def assemble(b: Bounds, ns: np.ndarray, pose: np.ndarray, twist: np.ndarray,
     far = np.where(np.isfinite(rng[..., 1]), np.maximum(r_max, rng[..., 1]), r_max)
     reach = np.hypot(mount[..., 0], mount[..., 1]) + far + math.sqrt(2) * slack[..., 0]
     max_range = float(np.nextafter(reach[reading].max() if reading.any() else r_max.max(), np.inf))
-    q = sum(s.spec.q * p for s, p in zip(sensors, pers))
+    # an outlier beam spoils its own slot and its group's merged reading: q counts twice on merged scans
+    q = sum(s.spec.q * p * (2 if any(_width(s, m) > min(len(m.ranges), s.spec.beams or len(m.ranges))
+                                     for m in s.msgs) else 1) for s, p in zip(sensors, pers))  # fmt: skip
     return Assembled(records, t_rec, box[:, 0].copy(), box[:, 1].copy(), q, max_range, dropped,
                      tuple(slot_topics))  # fmt: skip
 

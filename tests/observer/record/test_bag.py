@@ -95,7 +95,8 @@ def test_the_laser_robot(fmt: str, tmp_path: Path) -> None:
     path, truths = laser_robot(fmt, tmp_path)
     log = read_log(path, parse_bounds(LASER))
     r, n = log.records, 59  # the last scan falls after the last odometry message: dropped
-    assert len(r) == n and r.n_sensors == 37 and log.dropped["outside_odometry"] == 1
+    # 37 kept beams, then the scan's 37 merged readings (one instant, tiling cones: observer.record.scan_merge)
+    assert len(r) == n and r.n_sensors == 74 and log.dropped["outside_odometry"] == 1
     assert log.frame_id == "odom" and log.topics == {
         "odometry": "/odom",
         "ranges[0]": "/scan",
@@ -109,11 +110,11 @@ def test_the_laser_robot(fmt: str, tmp_path: Path) -> None:
     assert (
         log.mounts["/scan"] == pytest.approx((0.78, 0.0, 0.0)) and log.mount_sources["/scan"] == "tf_static"
     )
-    assert np.allclose(r.mount, [0.78, 0.0]) and not r.centred and log.q == 2
+    assert np.allclose(r.mount, [0.78, 0.0]) and not r.centred and log.q == 4
     idx = np.round(np.linspace(0, 360, 37)).astype(int)
     inc = float(np.float32(math.pi / 360))
-    assert np.allclose(r.alpha[3], float(np.float32(-math.pi / 2)) + idx * inc)
-    assert np.allclose(r.gamma, inc / 2)
+    assert np.allclose(r.alpha[3, :37], float(np.float32(-math.pi / 2)) + idx * inc)
+    assert np.allclose(r.gamma[:, :37], inc / 2) and np.median(r.gamma[:, 37:]) >= 4 * inc
     # no compass: the start heading, then nothing
     assert (
         r.heading[0].tolist() == [0.0, 0.0]
@@ -132,8 +133,8 @@ def test_the_laser_robot(fmt: str, tmp_path: Path) -> None:
     assert np.array_equal(r.mean_velocity[0], UNMEASURED)
     # readings: bound [0, 0], so only the float32 widening holds the float64 truth
     for k in range(n):
-        tr = truths[k][idx]
-        echo = np.isfinite(tr) & (tr < 20.0)
+        tr = np.concatenate([truths[k][idx], np.full(37, -1.0)])  # the kept beams (the merged ones below)
+        echo = np.isfinite(tr) & (tr < 20.0) & (tr >= 0)
         assert np.all((r.range[k, echo, 0] <= tr[echo]) & (tr[echo] <= r.range[k, echo, 1]))
         assert np.all(r.range[k, echo, 1] > r.range[k, echo, 0])  # widened although the bound is 0
         assert np.all(r.no_echo[k, np.isposinf(tr)]) and np.all(r.r_max[k, np.isposinf(tr)] == 20.0)
@@ -145,7 +146,17 @@ def test_the_laser_robot(fmt: str, tmp_path: Path) -> None:
             and np.all(r.r_max[k, far] <= 20.0)
             and np.all(r.r_max[k, far] <= tr[far])
         )
-    assert log.dropped["nan_beams"] == sum(int(np.isnan(tt[idx]).sum()) for tt in truths[:n])
+    assert log.dropped["nan_beams"] == sum(int(np.isnan(tt).sum()) for tt in truths[:n])  # every beam read
+    # each merged reading holds the nearest truth of the beams it spans, and digs no further than any of them
+    a0 = float(np.float32(-math.pi / 2))
+    for k in range(n):
+        for g in range(37, 74):
+            first = round((r.alpha[k, g] - r.gamma[k, g] - a0 + inc / 2) / inc)
+            last = round((r.alpha[k, g] + r.gamma[k, g] - a0 - inc / 2) / inc)
+            tr = truths[k][first : last + 1]
+            assert not np.isnan(tr).any()  # a run of beams that read
+            near = min(float(np.min(tr)), 20.0)
+            assert r.range[k, g, 0] <= near and (r.no_echo[k, g] or near <= r.range[k, g, 1])
     # asynchronous stamps: 20 ms after the record, slack = 0.02 s times the limits, rounded up
     assert np.all(r.slack[..., 0] >= 0.02 * 1.5) and np.all(r.slack[..., 0] <= 0.02 * 1.5 * (1 + 1e-9))
     assert np.all(r.slack[..., 1] >= 0.02 * 2.0)
