@@ -34,8 +34,10 @@ the best baseline with its paired bootstrap 95 % interval), writes ``leaderboard
 ``--model`` takes any model of ``digslam train``, a goal-selection MaskablePPO model included.
 
 Usage: ``python benchmarks/bench_agents.py [--quick] [--maps 30] [--steps 3000] [--out DIR] [--model PATH]
-[--chooser PATH] [--set KEY=VALUE ...] [--generators G ...] [--agents A ...] [--from F ...] [--ray [--address A]
-[--workers N]]`` (also ``digslam benchmark agents ...``). ``--set`` gives every agent and generator an
+[--chooser PATH] [--split test|validation] [--set KEY=VALUE ...] [--generators G ...] [--agents A ...] [--from F ...] [--ray [--address A]
+[--workers N]]`` (also ``digslam benchmark agents ...``). ``--split validation`` runs the same suite on the validation
+split's levels, where every setting of an agent or predictor is chosen (the test split is run once, at the
+end, and its figure chooses nothing); ``--from`` refuses to merge runs of different splits. ``--set`` gives every agent and generator an
 environment keyword (``--set grid_cell=0.078125``: the observer on a grid twice as fine; ``--set
 'noise={speed=0.0, yaw_rate=0.0}'``: exact odometry, the certified ceiling of a planner when the pose box
 does not drift); ``--generators`` runs some generators only; ``--agents`` some agents only (``--agents
@@ -132,7 +134,10 @@ def load_ppo(model: Path) -> Any:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--maps", type=int, default=30, help="test levels per generator (default 30)")
+    ap.add_argument("--maps", type=int, default=30, help="levels per generator (default 30)")
+    ap.add_argument("--split", choices=("test", "validation"), default="test",
+                    help="the levels: the test split (the headline, run once at the end) or the validation "
+                         "split (where every setting is chosen)")  # fmt: skip
     ap.add_argument("--steps", type=int, default=3000, help="steps per episode (default 3000)")
     ap.add_argument("--quick", action="store_true", help="a smoke run: 3 maps, 300 steps")
     ap.add_argument("--model", type=Path, default=MODEL, help="the learned model of the ppo row (.zip)")
@@ -209,12 +214,12 @@ def main() -> None:
         extra = {name: dict(common) for name in baselines} | extra
         res = run_suite_ray(specs, n_maps=maps, steps=steps, generators=args.generators, agent_env_kwargs=extra,
                             address=args.address, workers=args.workers, policy_env=ENV_ID, policy_seed=0,
-                            progress=True)  # fmt: skip
+                            progress=True, split=args.split)  # fmt: skip
     else:
         res = run_suite(policies, n_maps=maps, steps=steps, generators=args.generators, agent_env_kwargs=extra,
-                        progress=True)  # fmt: skip
+                        progress=True, split=args.split)  # fmt: skip
     wall = time.perf_counter() - t0
-    print(f"{len(res.results)} generators x {maps} test maps (seeds {res.seeds[0]}..{res.seeds[-1]}), "
+    print(f"{len(res.results)} generators x {maps} {res.split} maps (seeds {res.seeds[0]}..{res.seeds[-1]}), "
           f"{steps} steps, target 1.0; {wall:.0f} s")  # fmt: skip
     table = res.table(baselines)
     print(table)

@@ -25,6 +25,7 @@
 from __future__ import annotations
 
 import math
+import pickle
 import sys
 import time
 from dataclasses import field
@@ -207,7 +208,12 @@ def fit(cfg: PredictorConfig, command: str | None = None) -> Path:
     sched = torch.optim.lr_scheduler.OneCycleLR(opt, max_lr=cfg.lr, total_steps=cfg.epochs * per_epoch)
     ckpt, epoch, spent = out / "checkpoint.pt", 0, 0.0
     if ckpt.is_file():
-        state = torch.load(ckpt, map_location=device, weights_only=False)
+        try:  # tensors and plain values only: a checkpoint from elsewhere cannot run code here
+            state = torch.load(ckpt, map_location=device, weights_only=True)
+        except pickle.UnpicklingError as exc:
+            why = str(exc).splitlines()[0]
+            raise ValueError(f"{ckpt}: not a checkpoint of this trainer (it holds more than tensors and "
+                             f"plain values: {why}); move it away to start afresh") from None
         net.load_state_dict(state["net"])
         opt.load_state_dict(state["opt"])
         sched.load_state_dict(state["sched"])

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
@@ -46,6 +47,15 @@ def test_tiny_training_then_demo_and_evaluate(tmp_path):
     assert (tmp_path / "run" / "checkpoint.pt").is_file() and any((tmp_path / "run" / "tb").iterdir())
     again = _digslam("train", str(CONFIG), *tiny, cwd=tmp_path)  # resumes: the one epoch is done already
     assert again.returncode == 0 and "resuming after epoch 1" in again.stdout
+    ckpt = tmp_path / "run" / "checkpoint.pt"
+    good = ckpt.read_bytes()
+    import torch
+
+    torch.save({"net": Fraction(1, 3)}, ckpt)  # a pickled object: loaded with weights_only=True, refused
+    bad = _digslam("train", str(CONFIG), *tiny, cwd=tmp_path)
+    assert bad.returncode != 0 and "not a checkpoint of this trainer" in bad.stderr
+    assert "Traceback" not in bad.stderr
+    ckpt.write_bytes(good)
     demo = _digslam("demo", "--agent", "predictive_frontier", "--model", str(weights), "--steps", "40",
                     "--out", str(tmp_path / "demo"), cwd=tmp_path)  # fmt: skip
     assert demo.returncode == 0, demo.stderr[-2000:]
