@@ -212,8 +212,10 @@ def fit(cfg: PredictorConfig, command: str | None = None) -> Path:
             state = torch.load(ckpt, map_location=device, weights_only=True)
         except pickle.UnpicklingError as exc:
             why = str(exc).splitlines()[0]
-            raise ValueError(f"{ckpt}: not a checkpoint of this trainer (it holds more than tensors and "
-                             f"plain values: {why}); move it away to start afresh") from None
+            raise ValueError(
+                f"{ckpt}: not a checkpoint of this trainer (it holds more than tensors and "
+                f"plain values: {why}); move it away to start afresh"
+            ) from None
         net.load_state_dict(state["net"])
         opt.load_state_dict(state["opt"])
         sched.load_state_dict(state["sched"])
