@@ -98,6 +98,22 @@ def _rgb(code: Any) -> tuple[float, float, float]:
     return (r / 255, g / 255, b / 255)
 
 
+def _view(cert: Certified, lo: np.ndarray, hi: np.ndarray) -> tuple[float, float, float, float] | None:
+    """What the map shows: the cells sensed (clear or penumbra) and the pose boxes, with a 5 % margin, inside
+    the frame (the frame itself reaches the longest trusted range around the dead reckoning)."""
+    g = cert.grid
+    rows, cols = np.nonzero(cert.code != DARK)
+    x = [g.xs[cols.min()], g.xs[cols.max() + 1]] if cols.size else []
+    y = [g.ys[rows.max() + 1], g.ys[rows.min()]] if rows.size else []
+    x += [float(lo[:, 0].min()), float(hi[:, 0].max())] if len(lo) else []
+    y += [float(lo[:, 1].min()), float(hi[:, 1].max())] if len(lo) else []
+    if not x:
+        return None
+    pad = 0.05 * max(max(x) - min(x), max(y) - min(y), 10 * g.cell_size[0])
+    return (max(g.lo[0], min(x) - pad), max(g.lo[1], min(y) - pad), min(g.hi[0], max(x) + pad),
+            min(g.hi[1], max(y) + pad))  # fmt: skip
+
+
 def write_map(path: Path, cert: Certified, title: str) -> None:
     """Draw the zones, ``M⁻``'s outline and the pose boxes, with the demo's legend and a scale bar."""
     import matplotlib
@@ -121,10 +137,18 @@ def write_map(path: Path, cert: Certified, title: str) -> None:
     ax.add_collection(LineCollection(rings, colors="white", linewidths=0.6))
     ok = np.isfinite(cert.lo).all(axis=1) & np.isfinite(cert.hi).all(axis=1)
     lo, hi = cert.lo[ok], cert.hi[ok]
-    boxes = np.stack([lo, np.stack([hi[:, 0], lo[:, 1]], 1), hi, np.stack([lo[:, 0], hi[:, 1]], 1)], axis=1)
+    pick = np.unique(np.linspace(0, len(lo) - 1, min(len(lo), 60)).astype(int)) if len(lo) else []
+    b_lo, b_hi = lo[pick], hi[pick]  # at most 60 boxes of the tube, evenly in time, the last included
+    corner_a, corner_b = np.stack([b_hi[:, 0], b_lo[:, 1]], 1), np.stack([b_lo[:, 0], b_hi[:, 1]], 1)
+    boxes = np.stack([b_lo, corner_a, b_hi, corner_b], axis=1)
     ax.add_collection(
         PolyCollection(list(boxes), facecolors="none", edgecolors=(0.0, 0.62, 0.45), linewidths=0.5)
     )
+    view = _view(cert, lo, hi)
+    if view is not None:
+        ax.set_xlim(view[0], view[2])
+        ax.set_ylim(view[1], view[3])
+        w, h = view[2] - view[0], view[3] - view[1]
     bar = _scale(w)
     ax.add_artist(AnchoredSizeBar(ax.transData, bar, f"{bar:g} m", "lower right", color="white",
                                   frameon=False, size_vertical=h / 200))  # fmt: skip
