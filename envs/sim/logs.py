@@ -19,7 +19,8 @@ What is recorded (noise uniform inside each bound, :class:`SimNoise`):
   message's float32 fields, summed in float64, plus the mount's yaw) of half-aperture ``angle_increment/2``;
   its value is the exact sector distance from the apex ``x + R(ψ) m`` plus noise, stored as float32; +inf
   where the value would exceed ``range_max`` or nothing lies within it (REP 117), NaN where the truth cannot
-  be decided (an obstacle within the pose error of the range limit). The apex's rigorous box: the proved
+  be decided (its rigorous box is open or wider than 1e-6 m: an obstacle point within the pose error of the
+  cone's edge or of the range limit). The apex's rigorous box: the proved
   position error plus the rounding of ``R(ψ) m`` (:func:`apex`), fed to
   :meth:`~.sensors.SensorSuite.range_bounds`.
 * ``/imu`` (``sensor_msgs/Imu``, ``compass=True``): the heading plus noise, at the odometry stamps.
@@ -59,6 +60,9 @@ from digslam.observer.record.streams import (
 
 _U, _ETA = 2.0**-53, 5e-324
 _F32 = np.float32
+#: A beam whose truth box is wider than this (m) reads NaN: an obstacle point lies within the pose error of
+#: the cone's edge, so the truth is one of two far-apart distances (millions of beams meet a few).
+_UNDECIDED = 1e-6
 
 
 @dataclass(frozen=True)
@@ -269,7 +273,7 @@ def _record(odo_pose: np.ndarray, v: np.ndarray, w: np.ndarray, sb: np.ndarray, 
     c = np.where(np.isfinite(z), 0.5 * (a + z), a)
     ab, rel = noise.range
     val = c + rng.uniform(-1.0, 1.0, c.shape) * ((ab + rel * c) / (1.0 + rel))
-    val = np.where(np.isfinite(z), val, np.nan)  # undecided truth: an erroneous beam
+    val = np.where(z - a <= _UNDECIDED, val, np.nan)  # undecided truth (a wide or open box): erroneous
     val = np.where((a > float(_F32(laser.range_max))) | (val > float(_F32(laser.range_max))), np.inf, val)
     a0, inc = laser.angles()
     scan = ScanStream(scans + t0, val.astype(np.float32), a0, inc, laser.range_min, laser.range_max,
