@@ -33,6 +33,8 @@ KEYS: dict[str, tuple[str, ...]] = {
         "bench_agents": "best_heuristic heuristic_level_success eval_steps_per_s eval_over_observed speedup "
         "oracle_speedup predictor_iou_dark",
         "bench_cold_start": "cold_first_contract_s warm_first_contract_s cold_over_warm_contract",
+        "bench_certify": "certify_realtime_factor certify_realtime_factor_all_beams online_realtime_factor "
+        "certify_peak_mb",
         "bench_levels": "levels_match",
         "bench_digslam": "seconds offline_over_online_coverage offline_over_online_coverage_min "
         "offline_over_online_coverage_rooms truth_in_offline_tube dig_slam_over_thesis",
