@@ -87,8 +87,8 @@ def cmd_record(args: argparse.Namespace) -> int:
 
 
 def _write_bag(ep: Any, out: Path, bounds_path: Path, fmt: str) -> None:
-    """Write the episode as a ROS bag and its bounds file (:mod:`digslam.envs.sim.episode_log`)."""
-    from digslam.envs.sim.episode_log import episode_streams
+    """Write the episode as a ROS bag and its bounds file (:mod:`digslam.envs.sim.logs.episode`)."""
+    from digslam.envs.sim.logs.episode import episode_streams
     from digslam.observer.record.bag_write import LogWriteError, write_log
 
     streams, text = episode_streams(ep.records, ep.truth.pose, ep.config)

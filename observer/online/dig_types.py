@@ -8,8 +8,8 @@ the kernels of :mod:`.dig_jit`, :mod:`.mark_jit`, :mod:`.pose_jit`, :mod:`.step_
 :mod:`.smooth_jit` share them; numba passes them as records.
 
 >>> box = PoseBox(0.0, 0.0, 1.0, 1.0, -0.1, 0.1)
->>> box.x_hi - box.x_lo, StepRecord._fields[-1]
-(1.0, 'mean_velocity')
+>>> box.x_hi - box.x_lo, StepRecord._fields[-3:]
+(1.0, ('mean_velocity', 'mount', 'slack'))
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
 """Simulated robot logs with exact truth, in the streams a robot records (ROS bags through
 :func:`~digslam.observer.record.bag_write.write_log`).
 
-The robot drives a scripted path (:mod:`.log_path`: a tour of the world's reachable space, pure pursuit) on
-the project's exact arcs (:mod:`.arc_jit`). Time is integer nanoseconds: odometry every ``1/odom_rate`` s,
+The robot drives a scripted path (:mod:`.path`: a tour of the world's reachable space, pure pursuit) on
+the project's exact arcs (:mod:`digslam.envs.sim.arc_jit`). Time is integer nanoseconds: odometry every ``1/odom_rate`` s,
 laser scans every ``1/laser.rate`` s from ``laser.phase``; the truth is a chain of arcs between consecutive
 stamps of either kind. The command ``(v, w)`` is set at each odometry stamp and held until the next, so the
 true speed is constant over an odometry slice and the true yaw rate moves only by rounding between its pieces
@@ -14,7 +14,7 @@ What is recorded (noise uniform inside each bound, :class:`SimNoise`):
 * ``/odom`` (``nav_msgs/Odometry``): the twist is the measured body velocity, ``v1 = v + e``, ``v2 = 0``,
   ``w = ŵ + e'`` (``ŵ`` the midpoint of the slice's yaw-rate hull); the pose is the integral of the measured
   twist by the same arcs, from the true start pose. So ``source = "twist"`` holds under the noise bound, and
-  ``source = "pose"`` under it plus the arc's geometry (:mod:`.log_bounds`).
+  ``source = "pose"`` under it plus the arc's geometry (:mod:`.bounds`).
 * ``/scan`` (``sensor_msgs/LaserScan``): beam ``j`` is the cone along ``angle_min + j·angle_increment`` (the
   message's float32 fields, summed in float64, plus the mount's yaw) of half-aperture ``angle_increment/2``;
   its value is the exact sector distance from the apex ``x + R(ψ) m`` plus noise, stored as float32; +inf
@@ -22,11 +22,11 @@ What is recorded (noise uniform inside each bound, :class:`SimNoise`):
   be decided (its rigorous box is open or wider than 1e-6 m: an obstacle point within the pose error of the
   cone's edge or of the range limit). The apex's rigorous box: the proved
   position error plus the rounding of ``R(ψ) m`` (:func:`apex`), fed to
-  :meth:`~.sensors.SensorSuite.range_bounds`.
+  :meth:`~digslam.envs.sim.sensors.SensorSuite.range_bounds`.
 * ``/imu`` (``sensor_msgs/Imu``, ``compass=True``): the heading plus noise, at the odometry stamps.
 * ``/tf_static``: the laser's mount; ``/digslam/truth``: the true pose at every stamp.
 
-:meth:`SimLog.bounds` writes the matching bounds file (:mod:`.log_bounds`).
+:meth:`SimLog.bounds` writes the matching bounds file (:mod:`.bounds`).
 
 >>> log = simulate_log(duration=1.0, laser=LaserSpec(beams=5), seed=0)
 >>> len(log.streams.odometry), len(log.streams.scans[0]), log.scan_bounds.shape
@@ -43,7 +43,7 @@ import numpy as np
 
 from digslam.envs.sim.arc_jit import advance, arc_move, yaw_rate_bounds
 from digslam.envs.sim.generators import GENERATORS, ThesisRoom
-from digslam.envs.sim.log_path import PurePursuit, tour
+from digslam.envs.sim.logs.path import PurePursuit, tour
 from digslam.envs.sim.missions import THESIS_LOOP
 from digslam.envs.sim.sensors import SensorSuite
 from digslam.envs.sim.world import World
@@ -135,8 +135,8 @@ class SimLog:
     world: World = field(repr=False)
 
     def bounds(self, source: str = "pose", resolution: float = 0.1, beams: int | None = None) -> str:
-        """The bounds file (TOML) that this log satisfies (:func:`.log_bounds.bounds_text`)."""
-        from digslam.envs.sim.log_bounds import bounds_text
+        """The bounds file (TOML) that this log satisfies (:func:`.bounds.bounds_text`)."""
+        from digslam.envs.sim.logs.bounds import bounds_text
 
         return bounds_text(self, source, resolution, beams)
 
@@ -157,7 +157,7 @@ class SimLog:
 def apex(pose: np.ndarray, error: float, mount: tuple[float, float, float]) -> tuple[np.ndarray, float]:
     """The sensor's apex ``fl(x + R(ψ) m)`` and a proved bound of its error per coordinate: the position's
     ``error`` plus the rounding of ``R(ψ) m`` (``ψ`` exact; libm's cos/sin within ``2 L u``, then two
-    products, a sum and the final sum, each ``|r - exact| <= 2u|r| + η``), doubled as in :mod:`.arc_jit`."""
+    products, a sum and the final sum, each ``|r - exact| <= 2u|r| + η``), doubled as in :mod:`digslam.envs.sim.arc_jit`."""
     f, left = float(mount[0]), float(mount[1])
     if f == 0.0 and left == 0.0:
         return np.array([pose[0], pose[1]]), float(error)

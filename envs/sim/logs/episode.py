@@ -122,7 +122,7 @@ def episode_streams(rec: MissionRecord, pose: np.ndarray, cfg: ExploreConfig,
                          truth=PoseStream(stamps, pose[:, 0], pose[:, 1], pose[:, 2]))  # fmt: skip
     head = (
         f"# bounds of a digslam env episode ({cfg.dynamics}): the env's noise bounds plus a pad for the\n"
-        "# float widening and odometry hulls (see digslam.envs.sim.episode_log)\n"
+        "# float widening and odometry hulls (see digslam.envs.sim.logs.episode)\n"
     )
     return streams, head + b.to_toml()
 

@@ -42,7 +42,7 @@ from digslam.observer.record.bounds import (
     StartBounds,
 )
 
-#: A :class:`~digslam.envs.sim.logs.SimLog` (not imported: ``SimLog.bounds`` imports this module).
+#: A :class:`~digslam.envs.sim.logs.simulate.SimLog` (not imported: ``SimLog.bounds`` imports this module).
 SimLog = Any
 
 
@@ -131,7 +131,7 @@ def bounds_text(log: SimLog, source: str = "pose", resolution: float = 0.1, beam
             raise RuntimeError(f"{key}: the simulated log exceeds its derived bound by {e:.3g} (a bug)")
     head = (
         "# bounds of a simulated log (digslam.envs.sim.logs): the noise bounds plus the arc's geometry\n"
-        f"# (source = {source}) plus {p:g} for floating point; see digslam.envs.sim.log_bounds\n"
+        f"# (source = {source}) plus {p:g} for floating point; see digslam.envs.sim.logs.bounds\n"
     )
     return head + b.to_toml()
 
