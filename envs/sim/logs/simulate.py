@@ -1,13 +1,14 @@
 """Simulated robot logs with exact truth, in the streams a robot records (ROS bags through
 :func:`~digslam.observer.record.bag_write.write_log`).
 
-The robot drives a scripted path (:mod:`.path`: a tour of the world's reachable space, pure pursuit) on
-the project's exact arcs (:mod:`digslam.envs.sim.arc_jit`). Time is integer nanoseconds: odometry every ``1/odom_rate`` s,
-laser scans every ``1/laser.rate`` s from ``laser.phase``; the truth is a chain of arcs between consecutive
-stamps of either kind. The command ``(v, w)`` is set at each odometry stamp and held until the next, so the
-true speed is constant over an odometry slice and the true yaw rate moves only by rounding between its pieces
-(each piece's rate is bounded outward, and the real duration ``D`` of a piece differs from its float ``τ`` by
-at most ``u D``: the yaw rate is widened by ``2⁻⁵¹`` relative and the position error grows by ``2u v τ``).
+The robot drives a scripted path (:mod:`.path`: a tour of the world's reachable space, pure pursuit) on the
+project's exact arcs (:mod:`~digslam.envs.sim.arc_jit`). Time is integer nanoseconds: odometry every
+``1/odom_rate`` s, laser scans every ``1/laser.rate`` s from ``laser.phase``; the truth is a chain of arcs
+between consecutive stamps of either kind. The command ``(v, w)`` is set at each odometry stamp and held until
+the next, so the true speed is constant over an odometry slice and the true yaw rate moves only by rounding
+between its pieces (each piece's rate is bounded outward, and the real duration ``D`` of a piece differs from
+its float ``τ`` by at most ``u D``: the yaw rate is widened by ``2⁻⁵¹`` relative and the position error grows
+by ``2u v τ``).
 
 What is recorded (noise uniform inside each bound, :class:`SimNoise`):
 
@@ -157,7 +158,8 @@ class SimLog:
 def apex(pose: np.ndarray, error: float, mount: tuple[float, float, float]) -> tuple[np.ndarray, float]:
     """The sensor's apex ``fl(x + R(ψ) m)`` and a proved bound of its error per coordinate: the position's
     ``error`` plus the rounding of ``R(ψ) m`` (``ψ`` exact; libm's cos/sin within ``2 L u``, then two
-    products, a sum and the final sum, each ``|r - exact| <= 2u|r| + η``), doubled as in :mod:`digslam.envs.sim.arc_jit`."""
+    products, a sum and the final sum, each ``|r - exact| <= 2u|r| + η``), doubled as in
+    :mod:`~digslam.envs.sim.arc_jit`."""
     f, left = float(mount[0]), float(mount[1])
     if f == 0.0 and left == 0.0:
         return np.array([pose[0], pose[1]]), float(error)
