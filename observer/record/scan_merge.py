@@ -66,34 +66,40 @@ def merge_beams(
         beam that read is a no-reading slot (``[0, inf]``, its beams' mean direction).
     """
     n = alpha.size
-    out_a, out_g = np.empty(groups), np.full(groups, gamma_beam)
-    out_r, out_ne = np.empty(groups), np.zeros(groups, bool)
+    sizes = np.array([len(c) for c in np.array_split(np.arange(n), groups)])
+    g_start = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    group = np.repeat(np.arange(groups), sizes)
+    out_a = 0.5 * (alpha[g_start] + alpha[g_start + sizes - 1])
+    out_g, out_ne = np.full(groups, gamma_beam), np.zeros(groups, bool)
+    out_r = np.maximum.reduceat(r_max, g_start)
     out_y = np.tile([0.0, np.inf], (groups, 1))
-    for g, idx in enumerate(np.array_split(np.arange(n), groups)):
-        best, start = (0, 0), None
-        for k in list(idx) + [None]:
-            if k is not None and reading[k]:
-                start = k if start is None else start
-                continue
-            if start is not None:
-                end = (k if k is not None else int(idx[-1]) + 1) - 1
-                if end - start + 1 > best[1] - best[0]:
-                    best = (start, end + 1)
-                start = None
-        out_r[g] = float(np.max(r_max[idx]))
-        out_a[g] = 0.5 * (alpha[idx[0]] + alpha[idx[-1]])
-        i, j = best
-        if j == i:
-            continue
-        a_i, a_j = float(alpha[i]), float(alpha[j - 1])
-        out_a[g] = 0.5 * (a_i + a_j)
-        half = 0.5 * abs(a_j - a_i) + gamma_beam
-        out_g[g] = min(math.pi, half - 8 * _EPS * (abs(a_i) + abs(a_j) + half))
-        if np.all(no_echo[i:j]) and np.all(r_max[i:j] == r_max[i]):
-            out_ne[g] = True
-            out_r[g] = float(r_max[i])
-            out_y[g] = [out_r[g], np.inf]
-        else:  # an echo, or no echo up to different ranges: free to the nearest, sensed to the farthest
-            out_y[g] = [np.min(rng[i:j, 0]), np.max(rng[i:j, 1])]
-            out_r[g] = float(np.max(r_max[i:j]))
+    # runs of beams that read, cut at the groups' borders: starts, ends (exclusive) and lengths
+    first = reading & np.concatenate([[True], ~reading[:-1]])
+    first[g_start] = reading[g_start]
+    starts = np.flatnonzero(first)
+    if starts.size == 0:
+        return out_a, out_g, out_r, out_y, out_ne
+    stop = ~reading | np.isin(np.arange(n), g_start)  # where a run cannot go on
+    nxt = np.append(np.flatnonzero(stop), n)
+    ends = nxt[np.searchsorted(nxt, starts, side="right")]
+    length, g_of = ends - starts, group[starts]
+    best = np.lexsort((starts, -length, g_of))  # per group: the longest run, the first one on a tie
+    keep = best[np.concatenate([[True], g_of[best][1:] != g_of[best][:-1]])]
+    i, j, g = starts[keep], ends[keep], g_of[keep]
+    a_i, a_j = alpha[i], alpha[j - 1]
+    out_a[g] = 0.5 * (a_i + a_j)
+    half = 0.5 * np.abs(a_j - a_i) + gamma_beam
+    out_g[g] = np.minimum(math.pi, half - 8 * _EPS * (np.abs(a_i) + np.abs(a_j) + half))
+    cut = np.ravel(np.column_stack([i, j]))  # reduceat over [i, j) then skip the gaps between runs
+    cut = cut[:-1] if cut[-1] >= n else cut
+    lo = np.minimum.reduceat(rng[:, 0], cut)[::2][: len(i)]
+    hi = np.maximum.reduceat(rng[:, 1], cut)[::2][: len(i)]
+    r_hi = np.maximum.reduceat(r_max, cut)[::2][: len(i)]
+    r_lo = np.minimum.reduceat(r_max, cut)[::2][: len(i)]
+    quiet = np.minimum.reduceat(no_echo.astype(np.int8), cut)[::2][: len(i)] == 1
+    ne = quiet & (r_lo == r_hi)  # no echo up to one range
+    out_ne[g] = ne
+    out_r[g] = r_hi
+    out_y[g, 0] = np.where(ne, r_hi, lo)
+    out_y[g, 1] = np.where(ne, np.inf, hi)
     return out_a, out_g, out_r, out_y, out_ne
