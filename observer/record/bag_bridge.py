@@ -14,11 +14,13 @@ records, each interval rounded outward so that it holds every value the bounds f
   ``speed``, ``lateral`` and ``yaw_rate`` are the hull over the slices it spans (sound: each holds the truth
   on its part). ``source = "pose"``: the values are the pose increment, ``R(-psi_mid) (p_i - p_{i-1}) / dt``
   (``psi_mid`` the mean of the two yaws, the chord's direction on an arc) and ``(psi_i - psi_{i-1}) / dt``;
-  ``mean_velocity`` is ``R(-psi_{i-1}) (p_i - p_{i-1}) / dt`` with the speed and lateral bounds when the
-  record spans exactly one message, :data:`~digslam.observer.record.mission.UNMEASURED` otherwise.
+  ``mean_velocity`` is ``R(-psi_{i-1}) (p_i - p_{i-1}) / dt`` with the ``increment`` bound on both rows
+  (without one: the speed and lateral bounds) when the record spans exactly one message,
+  :data:`~digslam.observer.record.mission.UNMEASURED` otherwise.
   ``source = "twist"``: the values are the message's body-frame twist, and ``mean_velocity`` is unmeasured.
-  ``lateral`` omitted: ``[-max_speed, max_speed]`` (the premise); ``unicycle``: ``[0, 0]`` (the
-  increment's leftward row is then ``[-max_speed, max_speed]``: a turning unicycle's increment is not).
+  ``lateral`` omitted: ``[-max_speed, max_speed]`` (the premise); ``unicycle``: ``[0, 0]`` (without
+  ``increment``, the increment's leftward row is then ``[-max_speed, max_speed]``: a turning unicycle's
+  increment is not).
   Record 0's odometry bounds nothing the observers use: it is the premise's ``[-max, max]``.
 - **Readings** (REP 117): NaN dropped (``dropped["nan_beams"]``), ``-inf`` (too close) and values below
   ``range_min`` give no reading; ``+inf`` proves the cone free up to ``r_max`` (``min(max_range,
@@ -134,7 +136,7 @@ def _odometry(b: Bounds, ns: np.ndarray, pose: np.ndarray, twist: np.ndarray) ->
             out[j][1:] = widen(w, np.nextafter(bound_of(bound, w) + err3[:, j], np.inf))
     mean = np.full((n, 2, 2), np.nan)
     if o.source == "pose":
-        for j, bound in enumerate((o.speed, o.lateral)):
+        for j, bound in enumerate((o.speed, o.lateral) if o.increment is None else (o.increment,) * 2):
             if bound is not None:
                 mean[1:, j] = widen(d[:, j], np.nextafter(bound_of(bound, d[:, j]) + err, np.inf))
             else:  # the increment turns with the robot: never [0, 0], even for a unicycle

@@ -12,6 +12,7 @@ them and the longest range to trust. :func:`read_bounds` reads a file, :func:`pa
     speed = [0.02, 0.05]       # forward velocity v1: abs, rel (m/s)
     lateral = [0.02, 0.05]     # leftward v2; omitted or "none": |v2| <= max_speed; unicycle = true: v2 = 0
     yaw_rate = [0.005, 0.05]   # rad/s
+    increment = [0.001, 0.0]   # optional (source = "pose"): the pose increment's mean velocity, m/s
     max_speed = 2.0            # m/s, premise that bridges stamps
     max_yaw_rate = 2.0         # rad/s
     [heading]                  # optional: sensor_msgs/Imu orientation or nav_msgs/Odometry pose yaw
@@ -34,6 +35,13 @@ them and the longest range to trust. :func:`read_bounds` reads a file, :func:`pa
 
 Every error is a :class:`BoundsError`, one line that names the file: an unknown key (with the nearest known
 key), a bad value (the key, what it got, what it needs), a missing required key.
+
+``speed``, ``lateral`` and ``yaw_rate`` bound the instantaneous velocity and yaw rate over each odometry
+slice. ``increment`` (optional, ``source = "pose"`` only) bounds the pose increment's mean body velocity
+``R(-psi_prev) (p - p_prev) / dt`` (rows forward and leftward, both with this bound): odometry that reports
+pose increments knows them far better than the instantaneous velocity within a slice (a wheel slipping on
+contact). Without it the increment takes the ``speed`` and ``lateral`` bounds (``[-max_speed, max_speed]``
+for a row without one).
 """
 
 from __future__ import annotations
@@ -78,6 +86,7 @@ class OdometryBounds:
     source: str = "pose"
     lateral: Bound | None = None  # None: |v2| <= max_speed (or 0 with unicycle)
     unicycle: bool = False
+    increment: Bound | None = None  # None: the increment's rows take speed and lateral
 
 
 @dataclass(frozen=True)
@@ -140,8 +149,10 @@ class Bounds:
             lines.append(f"lateral = {_b(o.lateral)}")
         if o.unicycle:
             lines.append("unicycle = true")
-        lines += [f"yaw_rate = {_b(o.yaw_rate)}", f"max_speed = {o.max_speed!r}",
-                  f"max_yaw_rate = {o.max_yaw_rate!r}"]  # fmt: skip
+        lines.append(f"yaw_rate = {_b(o.yaw_rate)}")
+        if o.increment is not None:
+            lines.append(f"increment = {_b(o.increment)}")
+        lines += [f"max_speed = {o.max_speed!r}", f"max_yaw_rate = {o.max_yaw_rate!r}"]
         if self.heading is not None:
             lines += [
                 "",
@@ -176,7 +187,17 @@ def _b(b: Bound) -> str:
 
 _KEYS: dict[str, tuple[str, ...]] = {
     "": ("odometry", "heading", "start", "map", "ranges"),
-    "odometry": ("topic", "source", "speed", "lateral", "unicycle", "yaw_rate", "max_speed", "max_yaw_rate"),
+    "odometry": (
+        "topic",
+        "source",
+        "speed",
+        "lateral",
+        "unicycle",
+        "yaw_rate",
+        "increment",
+        "max_speed",
+        "max_yaw_rate",
+    ),
     "heading": ("topic", "bound"),
     "start": ("x", "y", "heading"),
     "map": ("resolution",),
@@ -305,10 +326,13 @@ class _Parser:
         lateral = None if t.get("lateral", "none") == "none" else self.bound(t, "lateral", w)
         if unicycle and lateral is not None:
             raise self.bad(w, "lateral", t["lateral"], 'to be omitted (or "none") with unicycle = true')
+        increment = self.bound(t, "increment", w) if "increment" in t else None
+        if increment is not None and source != "pose":
+            raise self.bad(w, "increment", t["increment"], 'source = "pose" (a twist carries no increment)')
         return OdometryBounds(
             topic=self.topic(t, w), speed=self.bound(t, "speed", w), yaw_rate=self.bound(t, "yaw_rate", w),
             max_speed=self.positive(t, "max_speed", w), max_yaw_rate=self.positive(t, "max_yaw_rate", w),
-            source=source, lateral=lateral, unicycle=unicycle,
+            source=source, lateral=lateral, unicycle=unicycle, increment=increment,
         )  # fmt: skip
 
     def ranges(self, data: Any, w: str) -> RangeBounds:

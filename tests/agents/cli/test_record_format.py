@@ -1,6 +1,6 @@
 """``digslam record --format mcap|sqlite3|bag``: the episode as a ROS bag plus ``bounds.toml``; read back, each
 reading's interval holds the env's own interval (so the truth) and exceeds it by the float32 rounding and
-the bounds file's pad only."""
+the bounds file's pad only; so does the pymunk odometry increment (``mean_velocity``), carried by the pose."""
 
 from __future__ import annotations
 
@@ -46,6 +46,11 @@ def test_bag_holds_the_env_intervals(tmp_path: Path, fmt: str, name: str, episod
     for f in ("speed", "yaw_rate", "heading"):
         a, b = getattr(env, f)[1:], getattr(got, f)[1:]
         assert np.all(b[:, 0] <= a[:, 0]) and np.all(a[:, 1] <= b[:, 1]), f
+    # pymunk (the default): the increment, on the pose (source = "pose"), as tight as the env's but the pad
+    assert episode.config.dynamics == "pymunk" and np.isfinite(env.mean_velocity).all()
+    a, b = env.mean_velocity[1:], got.mean_velocity[1:]
+    assert np.all(b[..., 0] <= a[..., 0]) and np.all(a[..., 1] <= b[..., 1])
+    assert np.max((b[..., 1] - b[..., 0]) - (a[..., 1] - a[..., 0])) <= 1e-8  # 2 x the 1e-9 pad, and err
     assert np.array_equal(log.x0_lo, episode.truth.pose[0]) and np.array_equal(
         log.x0_hi, episode.truth.pose[0]
     )

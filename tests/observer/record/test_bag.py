@@ -165,6 +165,31 @@ def test_the_laser_robot(fmt: str, tmp_path: Path) -> None:
     assert log.max_range >= 0.78 + 20.0
 
 
+def test_the_increment_bound_for_the_pose_source(tmp_path: Path) -> None:
+    """``increment`` bounds ``mean_velocity`` (both rows, ``+ err`` for the float of ``dp / dt``); the speed,
+    lateral and yaw-rate intervals are as without it."""
+    path, _ = laser_robot("mcap", tmp_path, n=12)
+    plain = read_log(path, parse_bounds(LASER)).records
+    r = read_log(path, parse_bounds(LASER.replace("unicycle", "increment = [0.001, 0.01]\nunicycle"))).records
+    for f in ("speed", "lateral", "yaw_rate", "t"):
+        assert np.array_equal(getattr(r, f), getattr(plain, f)), f
+    x, y, yaw = pose(np.arange(len(r)) * 0.25)  # the truth's increment: the circle's chord, turned back
+    dx, dy = np.diff(x), np.diff(y)
+    c, s = np.cos(yaw[:-1]), np.sin(yaw[:-1])
+    inc = np.stack([c * dx + s * dy, -s * dx + c * dy], 1) / 0.25
+    assert np.all(np.abs(inc[:, 1]) > 0.01)  # a turning unicycle's increment has a leftward row
+    # without it: the speed bound forward and, for a unicycle, [-max_speed, max_speed] leftward
+    assert np.all(plain.mean_velocity[1:, 1] == [-1.5, 1.5])
+    width = plain.mean_velocity[1:, 0, 1] - plain.mean_velocity[1:, 0, 0]
+    assert np.allclose(width, 2 * (0.02 + 0.05 * inc[:, 0]), rtol=0, atol=1e-12)
+    mv = r.mean_velocity[1:]
+    half = 0.5 * (mv[..., 1] - mv[..., 0])
+    assert np.all((mv[..., 0] <= inc) & (inc <= mv[..., 1]))
+    assert np.all(half >= 0.001 + 0.01 * np.abs(inc))  # the bound, plus err (< 1e-12 here)
+    assert np.allclose(half, 0.001 + 0.01 * np.abs(inc), rtol=0, atol=1e-12)
+    assert np.array_equal(r.mean_velocity[0], UNMEASURED)
+
+
 def test_a_bare_mcap_file_and_db3_file_read_as_their_folder(tmp_path: Path) -> None:
     for fmt, ext in (("mcap", "mcap"), ("sqlite3", "db3")):
         folder, _ = laser_robot(fmt, tmp_path, n=8)

@@ -62,6 +62,18 @@ def test_every_key_round_trips() -> None:
     assert parse_bounds(b.to_toml()) == b
 
 
+def test_the_increment_key_reads_and_round_trips() -> None:
+    assert parse_bounds(MINIMAL).odometry.increment is None  # default: the speed and lateral bounds
+    b = parse_bounds(MINIMAL.replace("speed", "increment = [0.001, 0.01]\nspeed", 1))
+    assert b.odometry.increment == Bound(0.001, 0.01) and b.odometry.source == "pose"
+    assert "increment = [0.001, 0.01]" in b.to_toml() and parse_bounds(b.to_toml()) == b
+    one = parse_bounds(
+        MINIMAL.replace("speed", 'source = "pose"\nunicycle = true\nincrement = 0.002\nspeed', 1)
+    )
+    assert one.odometry.increment == Bound(0.002, 0.0) and parse_bounds(one.to_toml()) == one
+    assert "increment" not in parse_bounds(MINIMAL).to_toml()
+
+
 def test_unicycle_and_lateral_none() -> None:
     assert parse_bounds(MINIMAL + "").odometry.lateral is None
     b = parse_bounds(MINIMAL.replace("speed", 'lateral = "none"\nunicycle = true\nspeed', 1))
@@ -109,6 +121,31 @@ def test_an_unknown_key_names_the_nearest() -> None:
             'topic = "/odom"',
             'topic = "/odom"\nunicycle = true\nlateral = [0.1, 0.0]',
             "lateral: got [0.1, 0.0]",
+        ),
+        (
+            'topic = "/odom"',
+            'topic = "/odom"\nincrement = [-0.001, 0.0]',
+            "increment: got [-0.001, 0.0], needs [abs",
+        ),
+        (
+            'topic = "/odom"',
+            'topic = "/odom"\nincrement = [0.1, 0.2, 0.3]',
+            "increment: got [0.1, 0.2, 0.3], needs",
+        ),
+        (
+            'topic = "/odom"',
+            'topic = "/odom"\nincrement = "tight"',
+            "increment: got 'tight', needs [abs, rel]",
+        ),
+        (
+            'topic = "/odom"',
+            'topic = "/odom"\nsource = "twist"\nincrement = [0.001, 0.0]',
+            'increment: got [0.001, 0.0], needs source = "pose" (a twist carries no increment)',
+        ),
+        (
+            'topic = "/odom"',
+            'topic = "/odom"\nincrements = 0.1',
+            "unknown key 'increments'; did you mean 'increment'?",
         ),
     ],
 )
