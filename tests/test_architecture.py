@@ -134,7 +134,9 @@ def test_the_kernel_rule_test_catches_a_cross_folder_call(tmp_path: Path) -> Non
 def test_observer_needs_only_numpy_scipy_numba() -> None:
     allowed = {"numpy", "scipy", "numba", "matplotlib", "mpmath"}  # matplotlib: paving.draw, on use only
     allowed |= {"typing_extensions"}  # core.config, under TYPE_CHECKING only (never imported at run time)
-    allowed |= {"rosbags"}  # record.bag: inside its functions only (the [ros] extra; a test imports without it)
+    allowed |= {
+        "rosbags"
+    }  # record.bag: inside its functions only (the [ros] extra; a test imports without it)
     stdlib = set(__import__("sys").stdlib_module_names)
     for m in MODS.values():
         if m.name.startswith("observer"):

@@ -137,7 +137,7 @@ def write_map(path: Path, cert: Certified, title: str) -> None:
     ax.add_collection(LineCollection(rings, colors="white", linewidths=0.6))
     ok = np.isfinite(cert.lo).all(axis=1) & np.isfinite(cert.hi).all(axis=1)
     lo, hi = cert.lo[ok], cert.hi[ok]
-    pick = np.unique(np.linspace(0, len(lo) - 1, min(len(lo), 60)).astype(int)) if len(lo) else []
+    pick = np.unique(np.linspace(0, max(len(lo) - 1, 0), min(len(lo), 60)).astype(int))
     b_lo, b_hi = lo[pick], hi[pick]  # at most 60 boxes of the tube, evenly in time, the last included
     corner_a, corner_b = np.stack([b_hi[:, 0], b_lo[:, 1]], 1), np.stack([b_lo[:, 0], b_hi[:, 1]], 1)
     boxes = np.stack([b_lo, corner_a, b_hi, corner_b], axis=1)

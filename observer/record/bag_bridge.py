@@ -106,7 +106,7 @@ def _unwrap(ns: np.ndarray, yaw: np.ndarray, rate: float, margin: float, what: s
     return np.unwrap(yaw)
 
 
-def _odometry(b: Bounds, ns: np.ndarray, pose: np.ndarray, twist: np.ndarray) -> tuple[np.ndarray, ...]:
+def slice_odometry(b: Bounds, ns: np.ndarray, pose: np.ndarray, twist: np.ndarray) -> tuple[np.ndarray, ...]:
     """Per-slice intervals (row ``i`` for slice ``[t_{i-1}, t_i]``, row 0 unused): speed, lateral, yaw_rate
     and the increment ``mean_velocity`` (``(n, 2, 2)``; NaN rows for the twist source)."""
     o = b.odometry
@@ -268,7 +268,7 @@ def assemble(b: Bounds, ns: np.ndarray, pose: np.ndarray, twist: np.ndarray,
                 alpha[k, sl_], gamma[k, sl_], r_max[k, sl_], rng[k, sl_], no_echo[k, sl_], slack[k, sl_] = (
                     a, gm, rm, rg, ne, sl)  # fmt: skip
         off += w * p
-    speed, lateral, yaw_rate, mean = _odometry(b, ns, pose, twist)
+    speed, lateral, yaw_rate, mean = slice_odometry(b, ns, pose, twist)
     prem = {0: o.max_speed, 1: o.max_speed, 2: o.max_yaw_rate}
     odo = []
     for j, arr in enumerate((speed, lateral, yaw_rate)):
@@ -313,4 +313,4 @@ def assemble(b: Bounds, ns: np.ndarray, pose: np.ndarray, twist: np.ndarray,
                      tuple(slot_topics))  # fmt: skip
 
 
-__all__ = ["Assembled", "Sensor", "assemble", "bound_of", "widen"]
+__all__ = ["Assembled", "Sensor", "assemble", "bound_of", "slice_odometry", "widen"]

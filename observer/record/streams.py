@@ -29,7 +29,7 @@ def _arrays(obj: object, names: tuple[str, ...], dtype: type = np.float64, ndim:
         k = int(np.argmax(np.diff(stamps) < 0)) + 1
         raise ValueError(f"stamps: message {k} goes backwards ({stamps[k - 1]} then {stamps[k]} ns)")
     for name in names:
-        arr = np.asarray(getattr(obj, name), dtype=dtype)
+        arr: np.ndarray = np.asarray(getattr(obj, name), dtype=dtype)
         if arr.ndim != ndim or arr.shape[0] != len(stamps):
             raise ValueError(f"{name}: expected {len(stamps)} rows (one per stamp), got shape {arr.shape}")
         object.__setattr__(obj, name, arr)

@@ -251,8 +251,10 @@ def thesis_dig_slam(
     if record.t.ndim != 1 or len(record) < 2:
         raise ValueError("record: expected a stacked mission of at least two samples")
     if not record.centred:
-        raise ValueError("record: thesis_dig_slam takes centred cones read at the record's instant (mount "
-                         "and slack zero); use dig_slam for mounted sensors")
+        raise ValueError(
+            "record: thesis_dig_slam takes centred cones read at the record's instant (mount "
+            "and slack zero); use dig_slam for mounted sensors"
+        )
     x0_lo, x0_hi = np.asarray(x0_lo, dtype=np.float64), np.asarray(x0_hi, dtype=np.float64)
     if x0_lo.shape != (2,) or x0_hi.shape != (2,) or np.any(x0_lo > x0_hi) or np.isnan(x0_lo + x0_hi).any():
         raise ValueError(f"x0_lo, x0_hi: expected a 2-d box, got {x0_lo} and {x0_hi}")

@@ -49,7 +49,7 @@ import numpy as np
 from digslam.envs.config import ExploreConfig
 from digslam.envs.sim.arc_jit import arc_move
 from digslam.envs.sim.sensors import SensorSuite
-from digslam.observer.record.bag_bridge import _odometry as _reader_odometry
+from digslam.observer.record.bag_bridge import slice_odometry
 from digslam.observer.record.bag_messages import yaw_of
 from digslam.observer.record.bounds import (
     Bound,
@@ -103,7 +103,7 @@ def _read_odometry(b: Bounds, odo: OdometryStream) -> tuple[np.ndarray, ...]:
     """The reader's per-slice intervals (speed, lateral, yaw_rate, mean_velocity; row 0 unused) of ``odo``
     under the odometry bounds of ``b`` (:mod:`digslam.observer.record.bag_bridge`)."""
     pose = np.column_stack([odo.x, odo.y, _read_yaw(odo.yaw)])
-    return _reader_odometry(b, odo.stamps, pose, np.column_stack([odo.v1, odo.v2, odo.yaw_rate]))
+    return slice_odometry(b, odo.stamps, pose, np.column_stack([odo.v1, odo.v2, odo.yaw_rate]))
 
 
 def _excess(c: np.ndarray, iv: np.ndarray) -> float:

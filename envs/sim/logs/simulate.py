@@ -283,7 +283,7 @@ def _record(odo_pose: np.ndarray, v: np.ndarray, w: np.ndarray, sb: np.ndarray, 
     heading = None
     if compass:
         heading = HeadingStream(odo + t0, odo_pose[:, 2] + rng.uniform(-1.0, 1.0, m) * noise.heading)
-    mount = Mount(laser.frame_id, *(float(c) for c in laser.mount))
+    mount = Mount(laser.frame_id, float(laser.mount[0]), float(laser.mount[1]), float(laser.mount[2]))
     truth = PoseStream(stamps + t0, P[:, 0], P[:, 1], P[:, 2])
     return LogStreams(odometry=o, scans=(scan,), heading=heading, mounts=(mount,), truth=truth), val
 
