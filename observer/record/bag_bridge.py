@@ -30,7 +30,7 @@ records, each interval rounded outward so that it holds every value the bounds f
   ``slack`` is ``(gap·max_speed, gap·max_yaw_rate)``, ``gap`` between the beam's instant (``stamp +
   i·time_increment``) and the record's, rounded up. With ``beams`` below a scan's count, the kept beams are
   evenly spread; when the scan's beams were taken at one instant and tile its field of view, the scan's
-  free space between them is kept too, as ``beams`` merged readings (:mod:`.scan_merge`).
+  free space between them is kept too, as ``merge`` merged readings (default ``beams``; :mod:`.scan_merge`).
 - **Heading.** With a compass: each record takes the nearest compass message (either side), ``yaw ±
   (bound + max_yaw_rate·gap)``. Yaw is unwrapped across messages (unique while ``max_yaw_rate·dt + 2·bound <
   pi`` between neighbours, else an error), on the branch nearest the ``[start]`` heading's centre when given.
@@ -144,15 +144,29 @@ def slice_odometry(b: Bounds, ns: np.ndarray, pose: np.ndarray, twist: np.ndarra
     return out[0], out[1], out[2], mean
 
 
+def _kept(spec: RangeBounds, n: int) -> np.ndarray:
+    """The beams of an ``n``-beam message kept as they are: ``beams`` of them evenly spread, or all."""
+    if spec.beams is None or spec.beams >= n:
+        return np.arange(n)
+    return np.unique(np.round(np.linspace(0, n - 1, spec.beams)).astype(np.int64))
+
+
+def _groups(spec: RangeBounds, msg: RangeMsg) -> int:
+    """How many merged readings a message gives (:mod:`.scan_merge`): ``merge`` (default ``beams`` when
+    that is below the message's count, else none), and none when its beams cannot be merged
+    (:func:`.scan_merge.can_merge`)."""
+    n = len(msg.ranges)
+    want = spec.merge if spec.merge is not None else (spec.beams if spec.beams is not None and spec.beams < n
+                                                      else 0)  # fmt: skip
+    gamma = spec.aperture if spec.aperture is not None else msg.gamma
+    if not want or n < 2 or not can_merge(msg.angle_increment, gamma, msg.time_increment):
+        return 0
+    return min(want, n)
+
+
 def _width(s: Sensor, msg: RangeMsg) -> int:
-    """How many slots one message of ``s`` fills: every beam, the ``beams`` kept, or those and as many
-    merged readings when the scan's beams can be merged (:func:`.scan_merge.can_merge`)."""
-    n, beams = len(msg.ranges), s.spec.beams
-    if beams is None or beams >= n:
-        return n
-    gamma = s.spec.aperture if s.spec.aperture is not None else msg.gamma
-    kept = len(np.unique(np.round(np.linspace(0, n - 1, beams)).astype(np.int64)))
-    return 2 * kept if can_merge(msg.angle_increment, gamma, msg.time_increment) else kept
+    """How many slots one message of ``s`` fills: the kept beams, then its merged readings."""
+    return len(_kept(s.spec, len(msg.ranges))) + _groups(s.spec, msg)
 
 
 def _slots(
@@ -160,15 +174,9 @@ def _slots(
 ) -> tuple[np.ndarray, ...]:
     """One message's kept beams: alpha, gamma, r_max, range (n, 2), no_echo, slack (n, 2)."""
     spec, n = s.spec, len(msg.ranges)
-    idx = np.arange(n)
     gamma = spec.aperture if spec.aperture is not None else msg.gamma
-    merge = spec.beams is not None and spec.beams < n and can_merge(msg.angle_increment, gamma,
-                                                                    msg.time_increment)  # fmt: skip
-    if spec.beams is not None and spec.beams < n:
-        idx = np.unique(np.round(np.linspace(0, n - 1, spec.beams)).astype(np.int64))
-    keep = idx
-    if merge:  # every beam read, then the kept ones and the scan merged (.scan_merge)
-        idx = np.arange(n)
+    keep, groups = _kept(spec, n), _groups(spec, msg)
+    idx = np.arange(n) if groups else keep  # merging reads every beam, then keeps some and merges all
     sensor_max = msg.range_max if math.isfinite(msg.range_max) and msg.range_max > 0 else math.inf
     eff = min(spec.max_range if spec.max_range is not None else math.inf, sensor_max)
     if not math.isfinite(eff):
@@ -200,17 +208,17 @@ def _slots(
     gap = np.abs((msg.ns - t_rec) * 1e-9 + idx * msg.time_increment) * (1 + 4 * _EPS)
     slack = np.stack([_up(gap * b.odometry.max_speed), _up(gap * b.odometry.max_yaw_rate)], axis=1)
     alpha = s.mount[2] + msg.angle_min + idx * msg.angle_increment
-    if not merge:
+    if not groups:
         return alpha, np.full(len(idx), gamma), r_max, rng, no_echo, slack
     reading = echo | no_echo
-    m_a, m_g, m_r, m_y, m_ne = merge_beams(alpha, gamma, rng, no_echo, r_max, reading, len(keep))
+    m_a, m_g, m_r, m_y, m_ne = merge_beams(alpha, gamma, rng, no_echo, r_max, reading, groups)
     return (
         np.concatenate([alpha[keep], m_a]),
         np.concatenate([np.full(len(keep), gamma), m_g]),
         np.concatenate([r_max[keep], m_r]),
         np.concatenate([rng[keep], m_y]),
         np.concatenate([no_echo[keep], m_ne]),
-        np.concatenate([slack[keep], slack[keep[: len(m_a)]]]),
+        np.concatenate([slack[keep], np.repeat(slack[:1], groups, axis=0)]),  # one instant: one slack
     )
 
 
@@ -307,8 +315,8 @@ def assemble(b: Bounds, ns: np.ndarray, pose: np.ndarray, twist: np.ndarray,
     reach = np.hypot(mount[..., 0], mount[..., 1]) + far + math.sqrt(2) * slack[..., 0]
     max_range = float(np.nextafter(reach[reading].max() if reading.any() else r_max.max(), np.inf))
     # an outlier beam spoils its own slot and its group's merged reading: q counts twice on merged scans
-    q = sum(s.spec.q * p * (2 if any(_width(s, m) > min(len(m.ranges), s.spec.beams or len(m.ranges))
-                                     for m in s.msgs) else 1) for s, p in zip(sensors, pers))  # fmt: skip
+    q = sum(s.spec.q * p * (2 if any(_groups(s.spec, m) for m in s.msgs) else 1)
+            for s, p in zip(sensors, pers))  # fmt: skip
     return Assembled(records, t_rec, box[:, 0].copy(), box[:, 1].copy(), q, max_range, dropped,
                      tuple(slot_topics))  # fmt: skip
 

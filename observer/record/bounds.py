@@ -28,6 +28,7 @@ them and the longest range to trust. :func:`read_bounds` reads a file, :func:`pa
     topic = "/scan"            # sensor_msgs/LaserScan or sensor_msgs/Range
     bound = [0.03, 0.01]       # m
     beams = 37                 # LaserScan: beams kept, evenly spread (default all)
+    merge = 37                 # LaserScan: merged readings per scan (default: beams, when below the count)
     aperture = 0.0087          # LaserScan: a beam's half-aperture (rad), default angle_increment / 2
     max_range = 20.0           # trust readings up to here (default the message's range_max)
     q = 2                      # outliers allowed per record on this sensor (default 0)
@@ -107,6 +108,7 @@ class RangeBounds:
     aperture: float | None = None
     max_range: float | None = None
     q: int = 0
+    merge: int | None = None
     mount: tuple[float, float, float] | None = None
 
 
@@ -168,7 +170,7 @@ class Bounds:
         lines += ["", "[map]", f"resolution = {self.map.resolution!r}"]
         for r in self.ranges:
             lines += ["", "[[ranges]]", f"topic = {_s(r.topic)}", f"bound = {_b(r.bound)}", f"q = {r.q}"]
-            for key in ("beams", "aperture", "max_range"):
+            for key in ("beams", "merge", "aperture", "max_range"):
                 if getattr(r, key) is not None:
                     lines.append(f"{key} = {getattr(r, key)!r}")
             if r.mount is not None:
@@ -201,7 +203,7 @@ _KEYS: dict[str, tuple[str, ...]] = {
     "heading": ("topic", "bound"),
     "start": ("x", "y", "heading"),
     "map": ("resolution",),
-    "ranges": ("topic", "bound", "beams", "aperture", "max_range", "q", "mount"),
+    "ranges": ("topic", "bound", "beams", "merge", "aperture", "max_range", "q", "mount"),
 }
 
 
@@ -337,9 +339,11 @@ class _Parser:
 
     def ranges(self, data: Any, w: str) -> RangeBounds:
         t = self.table(data, "ranges", w)
-        beams = t.get("beams")
+        beams, merge = t.get("beams"), t.get("merge")
         if beams is not None and not (isinstance(beams, int) and not isinstance(beams, bool) and beams >= 1):
             raise self.bad(w, "beams", beams, "an integer >= 1")
+        if merge is not None and not (isinstance(merge, int) and not isinstance(merge, bool) and merge >= 0):
+            raise self.bad(w, "merge", merge, "an integer >= 0 (0: no merged readings)")
         q = t.get("q", 0)
         if not (isinstance(q, int) and not isinstance(q, bool) and q >= 0):
             raise self.bad(w, "q", q, "an integer >= 0")
@@ -353,7 +357,7 @@ class _Parser:
             mount = (float(mount[0]), float(mount[1]), float(mount[2]))
         return RangeBounds(
             topic=self.topic(t, w), bound=self.bound(t, "bound", w), beams=beams, aperture=aperture,
-            max_range=self.positive(t, "max_range", w, None), q=q, mount=mount,
+            max_range=self.positive(t, "max_range", w, None), q=q, mount=mount, merge=merge,
         )  # fmt: skip
 
 

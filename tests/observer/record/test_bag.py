@@ -411,3 +411,17 @@ def test_an_odometry_pose_as_compass_and_an_imu_without_orientation(tmp_path: Pa
     assert "/imu at stamp 1700000000.000000000: the Imu has no orientation" in _fails(
         g.write(tmp_path / "c"), text
     )
+
+
+@pytest.mark.parametrize(("beams", "merge", "slots"), [(None, 37, 361 + 37), (None, None, 361), (37, 0, 37),
+                                                         (10, 20, 30)])  # fmt: skip
+def test_merged_readings_are_counted_apart_from_the_kept_beams(
+    tmp_path: Path, beams: int | None, merge: int | None, slots: int
+) -> None:
+    """``merge`` sets how many merged readings a scan gives, whatever ``beams`` keeps (default: ``beams``
+    when below the scan's count); ``q`` counts twice when there are some."""
+    path, _ = laser_robot("mcap", tmp_path, n=6)
+    text = LASER.replace("beams = 37\n", "" if beams is None else f"beams = {beams}\n")
+    text += "" if merge is None else f"merge = {merge}\n"
+    log = read_log(path, parse_bounds(text))
+    assert log.records.n_sensors == slots and log.q == (4 if slots > 361 or 0 < slots - (beams or 361) else 2)

@@ -53,12 +53,12 @@ def test_the_examples_read_and_round_trip(name: str) -> None:
 
 def test_every_key_round_trips() -> None:
     text = MINIMAL.replace("speed", 'source = "twist"\nlateral = [0.1, 0.2]\nspeed', 1) + (
-        "beams = 5\naperture = 0.01\nmax_range = 7.5\nq = 1\nmount = [0.5, -0.25, 0.1]\n"
+        "beams = 5\nmerge = 3\naperture = 0.01\nmax_range = 7.5\nq = 1\nmount = [0.5, -0.25, 0.1]\n"
         '[heading]\ntopic = "/imu"\nbound = [0.01, 0.001]\n'
         "[start]\nx = [-1.0, 1.0]\ny = [0.5, 0.75]\nheading = [3.0, 3.25]\n[map]\nresolution = 0.05\n"
     )
     b = parse_bounds(text)
-    assert b.odometry.lateral == Bound(0.1, 0.2) and b.start.heading == (3.0, 3.25)
+    assert b.odometry.lateral == Bound(0.1, 0.2) and b.start.heading == (3.0, 3.25) and b.ranges[0].merge == 3
     assert parse_bounds(b.to_toml()) == b
 
 
@@ -141,6 +141,11 @@ def test_an_unknown_key_names_the_nearest() -> None:
             'topic = "/odom"',
             'topic = "/odom"\nsource = "twist"\nincrement = [0.001, 0.0]',
             'increment: got [0.001, 0.0], needs source = "pose" (a twist carries no increment)',
+        ),
+        (
+            "[[ranges]]",
+            "[[ranges]]\nmerge = -1",
+            "merge: got -1, needs an integer >= 0",
         ),
         (
             'topic = "/odom"',
