@@ -108,8 +108,8 @@ class RangeBounds:
     aperture: float | None = None
     max_range: float | None = None
     q: int = 0
-    merge: int | None = None
     mount: tuple[float, float, float] | None = None
+    merge: int | None = None
 
 
 @dataclass(frozen=True)
