@@ -316,6 +316,32 @@ class Auditor:
             return bool(m < rho)
 
 
+def grid_cell_boxes(grid: Any, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The closed boxes ``(lo, hi)`` (each ``(m, 2)``) of the cells set in ``mask`` on ``grid`` (a
+    :class:`~digslam.observer.record.grid.Grid`: row 0 at the top)."""
+    r, c = np.nonzero(mask)
+    return np.stack([grid.xs[c], grid.ys[r + 1]], 1), np.stack([grid.xs[c + 1], grid.ys[r]], 1)
+
+
+def assert_cells_free(grid: Any, mask: np.ndarray, world: Any) -> None:
+    """No obstacle point in any cell of ``mask``: no edge of ``world`` meets the closed box (exact near the
+    edges), the box lies in the world's frame, and its centre is free by the even-odd rule (no edge meets the
+    box, so it is wholly free or wholly not)."""
+    lo, hi = grid_cell_boxes(grid, mask)
+    f, e = world.frame, world.edges
+    assert np.all((lo[:, 0] >= f[0]) & (lo[:, 1] >= f[1]) & (hi[:, 0] <= f[2]) & (hi[:, 1] <= f[3]))
+    ctr = 0.5 * (lo + hi)
+    half = 0.5 * np.hypot(*(hi - lo).T)
+    for i in np.flatnonzero(~(_seg_dist(ctr[:, 0], ctr[:, 1], e) > half * (1 + 1e-9) + 1e-9)):
+        near = np.all(
+            (np.minimum(e[:, :2], e[:, 2:]) <= hi[i]) & (np.maximum(e[:, :2], e[:, 2:]) >= lo[i]), axis=1
+        )
+        for k in np.flatnonzero(near):
+            assert not _box_edge_fraction(tuple(lo[i]), tuple(hi[i]), e[k]), f"cell {lo[i]} meets edge {e[k]}"
+    free = even_odd_free(ctr[:, 0], ctr[:, 1], e)
+    assert free.all(), f"cell {lo[int(np.argmin(free))]} claimed free lies inside an obstacle"
+
+
 def _box_cone_min_float(p: np.ndarray, lo: np.ndarray, hi: np.ndarray, phi: np.ndarray, gam: np.ndarray,
                         rho: np.ndarray) -> np.ndarray:  # fmt: skip
     """``(N, S)`` float distance from ``p`` to the nearest point of ``box ∩ cone_s`` (``inf`` if empty),

@@ -63,7 +63,8 @@ from typing import Any
 
 import numpy as np
 import pytest
-from auditor import _box_edge_fraction, _seg_dist, even_odd_free
+from auditor import assert_cells_free as check_free
+from auditor import grid_cell_boxes as cell_boxes
 
 from digslam.envs import ExploreEnv, record_episode
 from digslam.envs.sim.logs.episode import episode_streams
@@ -104,29 +105,6 @@ def actions(seed: int) -> np.ndarray:
 
 
 # --- the truth checks (none of the observer's code) ------------------------------------------------------
-def cell_boxes(grid: Grid, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    r, c = np.nonzero(mask)
-    return np.stack([grid.xs[c], grid.ys[r + 1]], 1), np.stack([grid.xs[c + 1], grid.ys[r]], 1)
-
-
-def check_free(grid: Grid, mask: np.ndarray, world: Any) -> None:
-    """No obstacle point in any cell of ``mask``: no edge meets the closed box (exact near the edges), the
-    box in the world's frame, its centre free by the even-odd rule."""
-    lo, hi = cell_boxes(grid, mask)
-    f, e = world.frame, world.edges
-    assert np.all((lo[:, 0] >= f[0]) & (lo[:, 1] >= f[1]) & (hi[:, 0] <= f[2]) & (hi[:, 1] <= f[3]))
-    ctr = 0.5 * (lo + hi)
-    half = 0.5 * np.hypot(*(hi - lo).T)
-    for i in np.flatnonzero(~(_seg_dist(ctr[:, 0], ctr[:, 1], e) > half * (1 + 1e-9) + 1e-9)):
-        near = np.all(
-            (np.minimum(e[:, :2], e[:, 2:]) <= hi[i]) & (np.maximum(e[:, :2], e[:, 2:]) >= lo[i]), axis=1
-        )
-        for k in np.flatnonzero(near):
-            assert not _box_edge_fraction(tuple(lo[i]), tuple(hi[i]), e[k]), f"cell {lo[i]} meets edge {e[k]}"
-    free = even_odd_free(ctr[:, 0], ctr[:, 1], e)
-    assert free.all(), f"cell {lo[int(np.argmin(free))]} claimed free lies inside an obstacle"
-
-
 def true_cones(ep: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Per step and sensor: the true position, direction, half-aperture and sensed radius
     ``min(true range, r_max)``."""

@@ -34,7 +34,8 @@ from typing import Any
 
 import numpy as np
 import pytest
-from auditor import _box_edge_fraction, _seg_dist, even_odd_free
+from auditor import assert_cells_free as check_free
+from auditor import grid_cell_boxes as cell_boxes
 
 from digslam.envs.sim.logs import LaserSpec, SimLog, simulate_log
 from digslam.observer.online.frame import frame_of
@@ -164,34 +165,12 @@ class Cones:
 
 
 # --- the checks ------------------------------------------------------------------------------------------
-def cell_boxes(grid: Grid, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    r, c = np.nonzero(mask)
-    return np.stack([grid.xs[c], grid.ys[r + 1]], 1), np.stack([grid.xs[c + 1], grid.ys[r]], 1)
-
-
 def check_pose(lo: np.ndarray, hi: np.ndarray, psi: np.ndarray, truth: np.ndarray, err: np.ndarray) -> None:
     """(a) The true position (error ``err`` counted against the claim) and heading in every box."""
     inside = np.all((lo <= truth[:, :2] - err[:, None]) & (truth[:, :2] + err[:, None] <= hi), axis=1)
     assert inside.all(), f"record {int(np.argmin(inside))}: the true position is outside its pose box"
     ok = (psi[:, 0] <= truth[:, 2]) & (truth[:, 2] <= psi[:, 1])
     assert ok.all(), f"record {int(np.argmin(ok))}: the true heading is outside its interval"
-
-
-def check_free(grid: Grid, mask: np.ndarray, world: Any) -> None:
-    """(b) No obstacle point in any cell of ``mask``."""
-    lo, hi = cell_boxes(grid, mask)
-    f, e = world.frame, world.edges
-    assert np.all((lo[:, 0] >= f[0]) & (lo[:, 1] >= f[1]) & (hi[:, 0] <= f[2]) & (hi[:, 1] <= f[3]))
-    ctr = 0.5 * (lo + hi)
-    half = 0.5 * np.hypot(*(hi - lo).T)
-    for i in np.flatnonzero(~(_seg_dist(ctr[:, 0], ctr[:, 1], e) > half * (1 + 1e-9) + 1e-9)):
-        near = np.all(
-            (np.minimum(e[:, :2], e[:, 2:]) <= hi[i]) & (np.maximum(e[:, :2], e[:, 2:]) >= lo[i]), axis=1
-        )
-        for k in np.flatnonzero(near):
-            assert not _box_edge_fraction(tuple(lo[i]), tuple(hi[i]), e[k]), f"cell {lo[i]} meets edge {e[k]}"
-    free = even_odd_free(ctr[:, 0], ctr[:, 1], e)  # no edge meets these boxes: each is wholly free or not
-    assert free.all(), f"cell {lo[int(np.argmin(free))]} claimed free lies inside an obstacle"
 
 
 def check_seen(grid: Grid, clear: np.ndarray, cones: Cones) -> None:
