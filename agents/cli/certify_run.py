@@ -3,9 +3,8 @@
 :func:`frame_grid` is the map's frame: the hull of the dead-reckoning tube (the odometry integrated from the
 start box with the heading tube of the compass and the gyro, forward only, outward rounded) widened by the
 longest trusted range plus the farthest mount and the largest reading slack, in cells of ``resolution``
-(:func:`digslam.observer.online.frame.frame_of`; where that refuses a record whose heading or dead reckoning
-contradicts itself, the same hull from the start box and what dead reckoning there is, so that the diagnosis
-can still run the observers on it). :func:`run_offline`
+(:func:`digslam.observer.online.frame.frame_of`; a record whose heading or dead reckoning contradicts itself
+is framed around its start box, so that the diagnosis can still run the observers on it). :func:`run_offline`
 is :func:`digslam.observer.online.smoother.dig_slam` (the fixpoint, thesis §6.4, Eq. 6.18–6.24) and
 :func:`run_online` the online filter :class:`~digslam.observer.online.observer.OnlineDigSlam` step by step,
 keeping its boxes; :func:`cross_check` compares them (both are sound: the offline sets must be at least as
@@ -26,9 +25,9 @@ from digslam.observer.online.observer import OnlineConfig, OnlineDigSlam
 from digslam.observer.online.smoother import dig_slam
 from digslam.observer.record.grid import Grid
 from digslam.observer.record.mission import MissionRecord
-from digslam.observer.slam.digslam import DigSlamConfig, DigSlamResult, odometry_increment, odometry_velocity
+from digslam.observer.slam.digslam import DigSlamConfig, DigSlamResult
 from digslam.observer.thick.cells import CLEAR, DARK
-from digslam.observer.tube.tube import Tube, ctc_deriv, heading_from_compass
+from digslam.observer.tube.tube import Tube, heading_from_compass
 
 #: The most cells a frame may hold (about 20 bytes a cell in the observers: 2.4 GB at this bound).
 MAX_CELLS = 120_000_000
@@ -40,44 +39,14 @@ def heading_tube(rec: MissionRecord) -> Tube:
                                 rec.yaw_rate[1:, 1])  # fmt: skip
 
 
-def _own_frame(rec: MissionRecord, x0_lo: np.ndarray, x0_hi: np.ndarray, max_range: float,
-               resolution: float) -> Grid:  # fmt: skip
-    heading = heading_tube(rec)
-    n = len(rec)
-    lo, hi = np.array(x0_lo[:2], dtype=np.float64), np.array(x0_hi[:2], dtype=np.float64)
-    if not heading.is_empty():
-        g_lo, g_hi = np.full((n, 2), -np.inf), np.full((n, 2), np.inf)
-        g_lo[0], g_hi[0] = lo, hi
-        u = odometry_velocity(rec, heading)
-        tube = ctc_deriv(
-            Tube(rec.t, g_lo, g_hi), *u, backward=False, increment=odometry_increment(rec, heading)
-        )
-        if not tube.is_empty():
-            lo = np.minimum(lo, np.min(np.concatenate([tube.gate_lo, tube.slice_lo]), axis=0))
-            hi = np.maximum(hi, np.max(np.concatenate([tube.gate_hi, tube.slice_hi]), axis=0))
-    if not (np.isfinite(lo).all() and np.isfinite(hi).all()):
-        raise UserError("the odometry does not bound the position (an unbounded speed); give finite "
-                        "[odometry] speed and lateral bounds")  # fmt: skip
-    reach = float(max_range) + float(np.max(np.abs(rec.mount), initial=0.0)) * np.sqrt(2.0)
-    reach += float(np.max(rec.slack[..., 0], initial=0.0)) + 2.0 * resolution
-    return Grid.from_cell_size(lo - reach, hi + reach, resolution)
-
-
 def frame_grid(rec: MissionRecord, x0_lo: Any, x0_hi: Any, max_range: float, resolution: float) -> Grid:
-    """The map's frame (see the module docstring); raises :class:`UserError` when it exceeds
-    :data:`MAX_CELLS`."""
+    """The map's frame (see the module docstring); raises :class:`UserError` on an unbounded dead reckoning or
+    a frame over :data:`MAX_CELLS` (a one-line message saying its size)."""
     try:
-        grid = frame_of(
-            rec, np.asarray(x0_lo)[:2], np.asarray(x0_hi)[:2], max_range, resolution, 4 * MAX_CELLS
-        )
-    except FrameError:  # a record that contradicts itself, or an unbounded or huge frame: see below
-        grid = _own_frame(rec, np.asarray(x0_lo), np.asarray(x0_hi), max_range, resolution)
-    if grid.n_cells > MAX_CELLS:
-        w, h = grid.hi[0] - grid.lo[0], grid.hi[1] - grid.lo[1]
-        raise UserError(f"the frame is {w:.0f} m x {h:.0f} m, {grid.n_cells:,} cells of {resolution} m "
-                        f"(about {20 * grid.n_cells / 1e9:.1f} GB); give a coarser [map] resolution or a "
-                        "shorter max_range")  # fmt: skip
-    return grid
+        return frame_of(rec, np.asarray(x0_lo)[:2], np.asarray(x0_hi)[:2], max_range, resolution, MAX_CELLS,
+                        contradicted=True)  # fmt: skip
+    except FrameError as exc:
+        raise UserError(str(exc)) from None
 
 
 def run_offline(rec: MissionRecord, grid: Grid, x0_lo: Any, x0_hi: Any, q: int) -> DigSlamResult:

@@ -54,7 +54,7 @@ class FrameError(ValueError):
 
 
 def frame_of(record: MissionRecord, x0_lo: Any, x0_hi: Any, max_range: float, resolution: float,
-             max_cells: int = 400_000_000) -> Grid:  # fmt: skip
+             max_cells: int = 400_000_000, contradicted: bool = False) -> Grid:  # fmt: skip
     """The grid the observers map ``record`` on (see the module docstring).
 
     Args:
@@ -63,29 +63,23 @@ def frame_of(record: MissionRecord, x0_lo: Any, x0_hi: Any, max_range: float, re
         max_range: the longest range any reading is trusted to (m); no-echo readings reach their ``r_max``.
         resolution: cell side (m).
         max_cells: refuse a frame of more cells than this (:class:`FrameError`, saying the size).
+        contradicted: a record whose heading or odometry contradicts itself (an empty tube) is framed around
+            its start box instead of refused: the frame a diagnosis runs the observers in to find where the
+            data break their bounds.
 
     Raises:
-        FrameError: on an empty or unbounded dead-reckoning tube, or a frame over ``max_cells``.
+        FrameError: on an empty (unless ``contradicted``) or unbounded dead-reckoning tube, or a frame over
+            ``max_cells``.
     """
     if not (resolution > 0 and math.isfinite(resolution)):
         raise FrameError(f"resolution: expected a finite cell size > 0 (m), got {resolution}")
     lo0, hi0 = np.asarray(x0_lo, np.float64)[:2], np.asarray(x0_hi, np.float64)[:2]
-    t = record.t
-    heading = heading_from_compass(t, record.heading[:, 0], record.heading[:, 1], record.yaw_rate[1:, 0],
-                                   record.yaw_rate[1:, 1])  # fmt: skip
-    if heading.is_empty():
-        at = heading.inconsistent_at if heading.inconsistent_at is not None else heading.first_empty()
-        raise FrameError(f"record {at}: the heading and the yaw rate contradict each other")
-    u, inc = odometry_velocity(record, heading), odometry_increment(record, heading)
-    n = t.shape[0]
-    g_lo, g_hi = np.full((n, 2), -np.inf), np.full((n, 2), np.inf)
-    g_lo[0], g_hi[0] = lo0, hi0
-    tube = ctc_deriv(Tube(t, g_lo, g_hi), *u, backward=False, increment=inc)
-    if tube.is_empty():
-        raise FrameError(f"record {tube.first_empty()}: the odometry contradicts itself")
-    lo, hi = tube.gate_lo.min(axis=0), tube.gate_hi.max(axis=0)
+    lo, hi = _hull(record, lo0, hi0, contradicted)
     if not (np.isfinite(lo).all() and np.isfinite(hi).all()):
-        raise FrameError("the dead reckoning is unbounded: give every record a finite speed interval")
+        raise FrameError(
+            "the dead reckoning is unbounded: give every record a finite speed interval (a log: "
+            "finite [odometry] speed and lateral bounds)"
+        )
     reach = max(float(max_range), float(np.max(record.r_max, initial=0.0)))
     mount = float(np.max(np.hypot(record.mount[..., 0], record.mount[..., 1]), initial=0.0))
     slack = float(np.max(record.slack[..., 0], initial=0.0)) * math.sqrt(2.0)
@@ -100,6 +94,30 @@ def frame_of(record: MissionRecord, x0_lo: Any, x0_hi: Any, max_range: float, re
             f"at {resolution} m: coarsen the map's resolution or trust shorter ranges"
         )
     return Grid((float(f_lo[0]), float(f_lo[1])), (float(f_hi[0]), float(f_hi[1])), (shape[1], shape[0]))
+
+
+def _hull(record: MissionRecord, lo0: np.ndarray, hi0: np.ndarray, contradicted: bool
+          ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """The hull of the dead-reckoning tube's gates (the start box's when the tube is empty and
+    ``contradicted``)."""
+    t = record.t
+    heading = heading_from_compass(t, record.heading[:, 0], record.heading[:, 1], record.yaw_rate[1:, 0],
+                                   record.yaw_rate[1:, 1])  # fmt: skip
+    if heading.is_empty():
+        if contradicted:
+            return lo0, hi0
+        at = heading.inconsistent_at if heading.inconsistent_at is not None else heading.first_empty()
+        raise FrameError(f"record {at}: the heading and the yaw rate contradict each other")
+    u, inc = odometry_velocity(record, heading), odometry_increment(record, heading)
+    n = t.shape[0]
+    g_lo, g_hi = np.full((n, 2), -np.inf), np.full((n, 2), np.inf)
+    g_lo[0], g_hi[0] = lo0, hi0
+    tube = ctc_deriv(Tube(t, g_lo, g_hi), *u, backward=False, increment=inc)
+    if tube.is_empty():
+        if contradicted:
+            return lo0, hi0
+        raise FrameError(f"record {tube.first_empty()}: the odometry contradicts itself")
+    return tube.gate_lo.min(axis=0), tube.gate_hi.max(axis=0)
 
 
 def frame_cost(grid: Grid, q: int = 0) -> int:

@@ -42,3 +42,13 @@ def test_bad_records_get_one_line() -> None:
     bad = MissionRecord(**(rec.as_dict() | {"heading": heading}))
     with pytest.raises(FrameError, match="contradict"):
         frame_of(bad, X0, X0, max_range=R_MAX, resolution=0.1)
+
+
+def test_a_contradicted_record_is_framed_around_its_start_for_the_diagnosis() -> None:
+    rec, _ = mission(MOUNT, 2, n=5)
+    heading = np.tile([3.0, 3.1], (5, 1))
+    heading[0] = 0.0
+    bad = MissionRecord(**(rec.as_dict() | {"heading": heading}))
+    g = frame_of(bad, X0, X0, max_range=R_MAX, resolution=0.1, contradicted=True)
+    reach = R_MAX + math.hypot(*MOUNT)
+    assert g.lo[0] <= X0[0] - reach and X0[0] + reach <= g.hi[0] and g.hi[0] - g.lo[0] < 2 * reach + 2.0
