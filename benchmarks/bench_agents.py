@@ -34,7 +34,7 @@ the best baseline with its paired bootstrap 95 % interval), writes ``leaderboard
 ``--model`` takes any model of ``digslam train``, a goal-selection MaskablePPO model included.
 
 Usage: ``python benchmarks/bench_agents.py [--quick] [--maps 30] [--steps 3000] [--out DIR] [--model PATH]
-[--chooser PATH] [--split test|validation] [--set KEY=VALUE ...] [--generators G ...] [--agents A ...] [--from F ...] [--ray [--address A]
+[--chooser PATH] [--predictive TOML] [--predictor PT] [--split test|validation] [--set KEY=VALUE ...] [--generators G ...] [--agents A ...] [--from F ...] [--ray [--address A]
 [--workers N]]`` (also ``digslam benchmark agents ...``). ``--split validation`` runs the same suite on the validation
 split's levels, where every setting of an agent or predictor is chosen (the test split is run once, at the
 end, and its figure chooses nothing); ``--from`` refuses to merge runs of different splits. ``--set`` gives every agent and generator an
@@ -148,6 +148,12 @@ def main() -> None:
     ap.add_argument(
         "--out", type=Path, default=Path("out/leaderboard"), help="where to write the leaderboard"
     )
+    ap.add_argument("--predictive", type=Path, default=None, metavar="TOML",
+                    help="settings of the predictive_frontier row and the oracle (default: the shipped "
+                         "agents/configs/predictive_frontier.toml)")  # fmt: skip
+    ap.add_argument("--predictor", type=Path, default=None, metavar="PT",
+                    help="map predictor of the predictive_frontier row (.pt of digslam train; default: the "
+                         "shipped one)")  # fmt: skip
     ap.add_argument("--ray", action="store_true", help="run the suite on Ray actors (identical results)")
     ap.add_argument("--address", default=None, help="with --ray: Ray cluster to attach to (default: local)")
     ap.add_argument("--workers", type=int, default=None, help="with --ray: actors (default: one per CPU)")
@@ -173,6 +179,7 @@ def main() -> None:
         if missing:
             raise ValueError(f"--from: no such file {missing[0]}")
         loaded = merge([SuiteResult.from_json(p) for p in args.sources]) if args.sources else None
+        check_predictive(args.predictive, args.predictor)
     except ValueError as exc:
         ap.error(str(exc).splitlines()[0])
     maps, steps = (3, 300) if args.quick else (args.maps, args.steps)
@@ -201,7 +208,7 @@ def main() -> None:
         extra["predictive_chooser"] = {**model_kwargs(args.chooser), **common}
     wanted = args.agents is None or "predictive_frontier" in args.agents
     if wanted and loaded is None:
-        add_predictive(policies, extra, common, args.ray)
+        add_predictive(policies, extra, common, args.ray, args.predictive, args.predictor)
     if common:
         print(f"environment keywords of every agent: {common}")
     t0 = time.perf_counter()
@@ -278,27 +285,49 @@ def print_speedup(res: SuiteResult, best: str, agent: str, key: str) -> None:
 
 
 def add_predictive(
-    policies: dict[str, Any], extra: dict[str, Any], common: dict[str, Any], ray: bool
-) -> None:
-    """The ``predictive_frontier`` row on the shipped map predictor and the ``oracle`` diagnosis beside it
-    (a factory: it reads the true map of the env it plays), or a printed note why not."""
+    policies: dict[str, Any], extra: dict[str, Any], common: dict[str, Any], ray: bool,
+    settings: Path | None = None, predictor: Path | None = None,
+) -> None:  # fmt: skip
+    """The ``predictive_frontier`` row on the map ``predictor`` (None: the shipped one) and the ``oracle``
+    diagnosis beside it (a factory: it reads the true map of the env it plays), both with the agent's
+    ``settings`` (None: the shipped ones), or a printed note why not."""
     if ray:
         print("note: predictive_frontier and the oracle run without --ray only; skipped")
         return
     try:
         from digslam.agents.prediction import make_predictive
         from digslam.agents.prediction.oracle import oracle_factory
+        from digslam.agents.prediction.settings import load_settings
 
+        chosen = load_settings(settings)
+        net = None
+        if predictor is not None:
+            from digslam.agents.prediction.model import load
+
+            net = load(predictor)
         env = gym.make(ENV_ID, **common)
         try:
-            policies["predictive_frontier"] = make_predictive(env, seed=0)
+            policies["predictive_frontier"] = make_predictive(env, predictor=net, seed=0, settings=chosen)
         finally:
             env.close()
     except (ImportError, ValueError) as exc:
         print(f"note: predictive_frontier skipped ({str(exc).splitlines()[0]})")
         return
-    policies[ORACLE] = oracle_factory()
+    policies[ORACLE] = oracle_factory(settings=chosen)
     extra["predictive_frontier"], extra[ORACLE] = dict(common), dict(common)
+
+
+def check_predictive(settings: Path | None, predictor: Path | None) -> None:
+    """A ``--predictive`` or ``--predictor`` the user names must load (``ValueError`` in one line)."""
+    if settings is not None:
+        from digslam.agents.prediction.settings import load_settings
+
+        try:
+            load_settings(settings)
+        except ValueError as exc:
+            raise ValueError(f"--predictive: {exc}") from None
+    if predictor is not None and not predictor.is_file():
+        raise ValueError(f"--predictor: no such file {predictor}")
 
 
 def predictor_iou() -> float | None:

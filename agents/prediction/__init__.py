@@ -7,9 +7,10 @@ U-Net, the observation's map in, a free probability per pixel out); :mod:`.fit` 
 (``digslam train agents/configs/map_predictor.toml``); :mod:`.quality` scores it against two baselines on
 the pixels the input leaves open; :mod:`.agent` holds ``predictive_frontier`` (the frontier agent with the
 gain read on the predicted map) and the true-map diagnosis :class:`~.agent.TrueMap`, which
-:mod:`.oracle` runs; :mod:`.features` gives the goal env's candidates the predicted gain and its spread
-as features (``candidate_features``), the inputs of the learned chooser ``predictive_chooser``
-(``digslam train agents/configs/goals_predictive.toml``).
+:mod:`.oracle` runs; :mod:`.gate` is its do-no-harm gate and :mod:`.settings` reads its settings
+(``agents/configs/predictive_frontier.toml``); :mod:`.features` gives the goal env's candidates the
+predicted gain and its spread as features (``candidate_features``), the inputs of the learned chooser
+``predictive_chooser`` (``digslam train agents/configs/goals_predictive.toml``).
 
 The prediction only ranks goals: every claim still comes from the observer, so a wrong prediction costs
 time, never soundness. Ground truth enters the training labels only, and the oracle diagnosis, which is
@@ -24,21 +25,30 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # the types; the agent (and torch) are imported on use
+    from pathlib import Path
+
     import gymnasium as gym
 
     from digslam.agents.prediction.agent import MapSource, PredictiveFrontierAgent
+    from digslam.agents.prediction.settings import PredictiveSettings
 
 
 def make_predictive(
-    env: gym.Env, predictor: MapSource | None = None, seed: int | None = None, **kw: Any
-) -> PredictiveFrontierAgent:
+    env: gym.Env, predictor: MapSource | None = None, seed: int | None = None,
+    settings: PredictiveSettings | str | Path | None = None, **kw: Any,
+) -> PredictiveFrontierAgent:  # fmt: skip
     """A :class:`~.agent.PredictiveFrontierAgent` sized from ``env`` (as the baselines are,
-    :func:`digslam.agents.baselines.registry.sizing`), reading ``predictor`` (None: the shipped one)."""
+    :func:`digslam.agents.baselines.registry.sizing`), reading ``predictor`` (None: the shipped one), with
+    ``settings`` (:class:`~.settings.PredictiveSettings` or its file; None: the shipped
+    ``agents/configs/predictive_frontier.toml``) and keyword overrides ``kw``."""
     from digslam.agents.baselines.registry import sizing
     from digslam.agents.prediction.agent import PredictiveFrontierAgent
+    from digslam.agents.prediction.settings import PredictiveSettings, load_settings
 
+    if not isinstance(settings, PredictiveSettings):
+        settings = load_settings(settings)
     return PredictiveFrontierAgent(env.action_space, env.observation_space, seed=seed, predictor=predictor,
-                                   **sizing(env), **kw)  # fmt: skip
+                                   **sizing(env), **{**settings.agent_kwargs(), **kw})  # fmt: skip
 
 
 __all__ = ["make_predictive"]

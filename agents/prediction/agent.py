@@ -24,12 +24,23 @@ A map source has ``free(image) -> (p, var)``, ``(m, m)`` float arrays from the o
   read from the env's ground truth. An upper bound of what a perfect predictor would give this planner,
   **not an agent**: only the oracle diagnosis (:mod:`.oracle`) builds it.
 
+**Do no harm** (:mod:`.gate`): at each plan the frontier agent's own pick (its costs, with its dark-share
+gain) is computed beside the predictive one, and the predictive pick stands only where, by the prediction's
+own path per gain, the frontier agent's pick is clearly worse; otherwise the agent plans with the frontier
+agent's costs. The settings, the gate's thresholds included, come from
+``agents/configs/predictive_frontier.toml`` (:mod:`.settings`).
+
+**A tour** (``tour_weight > 0``): the costs the gate gives get the tour regret of
+:class:`~digslam.agents.baselines.tour.TourFrontierAgent`, so that the goal starts the shortest open tour
+over the frontier clusters instead of being the best goal alone.
+
 The prediction is recomputed every ``predict_every`` steps (and on the first plan of an episode); every
 claim still comes from the observer, so a wrong prediction costs time, never soundness.
 """
 
 from __future__ import annotations
 
+import inspect
 import math
 from typing import Any, Protocol
 
@@ -39,8 +50,13 @@ from gymnasium import spaces
 
 from digslam.agents.baselines.frontier import FrontierAgent
 from digslam.agents.baselines.policy import Memory, View
+from digslam.agents.baselines.tour import TourFrontierAgent
 from digslam.agents.prediction.gain_jit import visible_gain
+from digslam.agents.prediction.gate import Gate
 from digslam.envs.stack import observer_of
+
+#: The frontier agent's own weight of its dark-share gain: the costs the gate falls back on are its costs.
+FRONTIER_GAIN_WEIGHT: float = inspect.signature(FrontierAgent.__init__).parameters["gain_weight"].default
 
 
 class MapSource(Protocol):
@@ -73,7 +89,7 @@ class TrueMap:
         return self._free, np.zeros_like(self._free)
 
 
-class PredictiveFrontierAgent(FrontierAgent):
+class PredictiveFrontierAgent(TourFrontierAgent):
     """Frontier agent with the predicted visible gain (module docstring).
 
     Args:
@@ -97,7 +113,12 @@ class PredictiveFrontierAgent(FrontierAgent):
             path times ``(gain_scale + gain_floor) / gain_floor``, not infinity.
         gain_scale: The gain (a share) at which the ratio equals ``c + path_offset`` (in pixels), so that
             the goal hysteresis (:func:`~digslam.agents.baselines.navigating.keep_bound`) keeps its meaning.
-        **kw: :class:`FrontierAgent` arguments.
+        gate: The do-no-harm gate (:class:`~.gate.Gate`); None: no gate (``Gate("off")``).
+        tour_weight: Weight of the tour regret over the frontier clusters, added to the costs the gate
+            gives (:class:`~digslam.agents.baselines.tour.TourFrontierAgent`); 0 (the default): one goal at a
+            time.
+        **kw: :class:`~digslam.agents.baselines.tour.TourFrontierAgent` and :class:`FrontierAgent`
+            arguments.
     """
 
     def __init__(self, action_space: spaces.Space, observation_space: spaces.Space | None = None,
@@ -106,7 +127,7 @@ class PredictiveFrontierAgent(FrontierAgent):
                  n_rays: int = 32, predicted_weight: float = 160.0, gain_weight: float = 0.0,
                  gain: str = "visible", count: str = "unknown", score: str = "ratio",
                  path_offset: float = 3.125, gain_floor: float = 0.01, gain_scale: float = 0.1,
-                 **kw: Any) -> None:  # fmt: skip
+                 gate: Gate | None = None, tour_weight: float = 0.0, **kw: Any) -> None:  # fmt: skip
         if gain not in ("visible", "area") or count not in ("unknown", "dark"):
             raise ValueError(
                 f"gain, count: must be 'visible'/'area' and 'unknown'/'dark', got {gain!r}, {count!r}"
@@ -116,6 +137,12 @@ class PredictiveFrontierAgent(FrontierAgent):
         for name, v in (("path_offset", path_offset), ("gain_floor", gain_floor), ("gain_scale", gain_scale)):
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
                 raise ValueError(f"{name}: must be finite and > 0, got {v!r}")
+        if gate is not None and not isinstance(gate, Gate):
+            raise ValueError(f"gate: expected a Gate (digslam.agents.prediction.gate), got {gate!r}")
+        if gate is not None and gate.mode != "off" and score != "ratio":
+            raise ValueError(f"gate: compares path per gain, so it needs score='ratio' (got {score!r}); "
+                             "set gate='off' for another score")  # fmt: skip
+        self.gate = gate if gate is not None else Gate("off")
         self.score, self.path_offset = score, float(path_offset)
         self.gain_floor, self.gain_scale = float(gain_floor), float(gain_scale)
         self.gain_mode, self.count = gain, count
@@ -133,7 +160,8 @@ class PredictiveFrontierAgent(FrontierAgent):
             raise ValueError("predictor: expected a map source with a free(image) method")
         self.predictor = predictor
         self.uncertainty, self.predict_every, self.n_rays = float(uncertainty), predict_every, n_rays
-        super().__init__(action_space, observation_space, seed, gain_weight=gain_weight, **kw)
+        super().__init__(action_space, observation_space, seed, gain_weight=gain_weight,
+                         tour_weight=tour_weight, **kw)  # fmt: skip
 
     def frontier_costs(self, view: View, mem: Memory, reach: np.ndarray, dist: np.ndarray) -> np.ndarray:
         """The frontier agent's costs ``c`` (path length, tier, turn; in pixels) turned into the cost of the
@@ -144,7 +172,8 @@ class PredictiveFrontierAgent(FrontierAgent):
           ``gain_scale`` costs its path plus ``path_offset``;
         * ``score="difference"``: ``c - predicted_weight g``, over the pixel side.
 
-        ``predicted_weight = 0`` leaves the frontier agent's costs as they are (no prediction)."""
+        ``predicted_weight = 0`` leaves the frontier agent's costs as they are (no prediction). The gate
+        (:meth:`gated`) then picks these costs or the frontier agent's."""
         cost = super().frontier_costs(view, mem, reach, dist)
         if self.predicted_weight <= 0:
             return cost
@@ -152,11 +181,39 @@ class PredictiveFrontierAgent(FrontierAgent):
         cand = np.isfinite(cost)
         gain = self.predicted_gain(view, mem, cand)
         if self.score == "difference":
-            return cost - self.predicted_weight * gain / px
-        out = np.full(cost.shape, np.inf)
-        scale = (self.gain_scale + self.gain_floor) / (gain[cand] + self.gain_floor)
-        out[cand] = (np.maximum(cost[cand], 0.0) + self.path_offset / px) * scale
-        return out
+            out = cost - self.predicted_weight * gain / px
+        else:
+            out = np.full(cost.shape, np.inf)
+            scale = (self.gain_scale + self.gain_floor) / (gain[cand] + self.gain_floor)
+            out[cand] = (np.maximum(cost[cand], 0.0) + self.path_offset / px) * scale
+        return self.gated(view, mem, cost, out)
+
+    def gated(self, view: View, mem: Memory, cost: np.ndarray, predictive: np.ndarray) -> np.ndarray:
+        """The costs to plan with: ``predictive`` where the gate keeps a predictive pick that differs from the
+        frontier agent's, else the frontier agent's (``cost`` less the frontier agent's dark-share gain,
+        :data:`FRONTIER_GAIN_WEIGHT`), so that a gate that never opens is the frontier agent, hysteresis
+        included. The picks are the least costs off the robot's own pixel, as :meth:`_plan` takes them;
+        the gate compares their ``predictive`` costs. Each decision is kept in ``mem.extra["gate"]``
+        (True: the prediction's pick) and counted in ``mem.extra["gate_counts"]`` (``[kept, closed]``).
+        With the gate off: always ``predictive``."""
+        if self.gate.mode == "off":
+            return predictive
+        px = self.px(cost.shape[0])
+        cand = np.isfinite(cost)
+        frontier = cost - (FRONTIER_GAIN_WEIGHT - self.gain_weight) * self.expected_gain(view, mem, cand) / px
+        picks = []
+        for c in (predictive, frontier):
+            c = c.copy()
+            c[view.cell] = np.inf
+            k = int(np.argmin(c))
+            picks.append(k if math.isfinite(float(c.flat[k])) else -1)
+        if min(picks) < 0 or picks[0] == picks[1]:
+            return frontier  # no candidate, or the prediction does not move the pick
+        keep = self.gate.keeps_prediction(float(predictive.flat[picks[0]]), float(predictive.flat[picks[1]]))
+        mem.extra["gate"] = keep
+        counts = mem.extra.setdefault("gate_counts", [0, 0])
+        counts[0 if keep else 1] += 1
+        return predictive if keep else frontier
 
     def prediction(self, view: View, mem: Memory) -> tuple[np.ndarray, np.ndarray]:
         """``(p, var)`` of the current map, recomputed every ``predict_every`` steps."""

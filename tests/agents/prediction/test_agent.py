@@ -11,6 +11,7 @@ import digslam.envs  # noqa: F401
 from digslam.agents.baselines.registry import make_baseline
 from digslam.agents.prediction import make_predictive
 from digslam.agents.prediction.agent import TrueMap
+from digslam.agents.prediction.gate import Gate
 from digslam.agents.prediction.oracle import ORACLE, oracle_suite
 from digslam.envs.dig_coverage.env import DigCoverageEnv
 from digslam.envs.sim.world import World
@@ -139,19 +140,21 @@ def _costs(agent, obs):
 
 def test_the_ratio_score_is_path_per_predicted_gain():
     """``score="ratio"``: ``(max(c, 0) + offset) (scale + floor) / (g + floor)`` on the candidates, ``inf``
-    elsewhere; ``"difference"``: ``c - w g / px``. Both rank by the same predicted gain ``g``."""
+    elsewhere; ``"difference"``: ``c - w g / px``. Both rank by the same predicted gain ``g`` (no gate:
+    ``test_gate.py`` checks what it does with these costs)."""
     env = gym.make("digslam/DigCoverage-v0", world="caves", fixed_world=False)
     obs, _ = env.reset(seed=1_000_002)
     for _ in range(20):
         obs, *_ = env.step(np.array([0.5, 0.3], np.float32))
-    ratio = make_predictive(env, predictor=_Uniform(0.7))
+    ratio = make_predictive(env, predictor=_Uniform(0.7), gate=Gate("off"))
     base, cost, gain = _costs(ratio, obs)
     cand = np.isfinite(base)
     px = ratio.px(base.shape[0])
     assert cand.any() and np.array_equal(np.isfinite(cost), cand) and gain[cand].max() > 0
     want = (np.maximum(base[cand], 0) + 3.125 / px) * (0.1 + 0.01) / (gain[cand] + 0.01)
     np.testing.assert_allclose(cost[cand], want)
-    diff = make_predictive(env, predictor=_Uniform(0.7), score="difference", predicted_weight=80.0)
+    diff = make_predictive(env, predictor=_Uniform(0.7), score="difference", predicted_weight=80.0,
+                           gate=Gate("off"))  # fmt: skip
     base, cost, gain = _costs(diff, obs)
     np.testing.assert_allclose(cost[cand], base[cand] - 80.0 * gain[cand] / px)
     with pytest.raises(ValueError, match="score: must be 'ratio' or 'difference'"):
