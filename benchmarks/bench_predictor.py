@@ -6,9 +6,9 @@ predictor (``agents/data/map_predictor.pt``, or ``--model``) and scores it on th
 penumbra in the input (:mod:`digslam.agents.prediction.quality`): accuracy, IoU of the free pixels and the
 calibration error (ECE), per generator and over all, beside ``base_rate`` (every open pixel free at the
 training set's free share, from the predictor's sidecar) and ``dilate`` (free within 3 pixels of the clear
-area). "All" is the procedural generators (:data:`~digslam.envs.sim.generators.PROCEDURAL`, what the
-shipped predictor trains on); the floorplan levels (windows of the validation plans, as the benchmark's,
-:data:`digslam.agents.evaluation.suite.GENERATORS`) are scored apart: the predictor never saw a real plan.
+area). "All" is the procedural generators (:data:`~digslam.envs.sim.generators.PROCEDURAL`); the floorplan levels (windows of the validation plans, as the benchmark's,
+:data:`digslam.agents.evaluation.suite.GENERATORS`) are scored apart: the shipped predictor saw windows of
+the six training plans only (``agents/configs/map_predictor_buildings.toml``), never the validation plans'.
 Ends with ``<metric>_<generator>=`` lines for the predictor, ``base_rate_iou=``, ``dilate_iou=``,
 ``base_rate_accuracy=``, ``dilate_accuracy=``, ``predictor_accuracy=``, ``predictor_ece=`` and
 ``predictor_iou_dark=`` (over the procedural generators), and ``predictor_iou_floorplan=`` (the floorplan

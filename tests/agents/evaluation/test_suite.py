@@ -66,9 +66,9 @@ def test_the_floorplan_levels_are_windows_of_the_registered_ids_size() -> None:
 
 
 def test_benchmark_agents_refuses_a_bad_setting_or_generator_in_one_line() -> None:
-    """``--set KEY=VALUE`` (an environment keyword for every agent), ``--generators`` and ``--agents`` are
-    checked before any episode: an unknown keyword, an item without ``=``, an unknown generator or agent is
-    one line, exit 2."""
+    """``--set KEY=VALUE`` (an environment keyword for every agent), ``--generators``, ``--agents``,
+    ``--predictive`` and ``--predictor`` are checked before any episode: an unknown keyword, an item without
+    ``=``, an unknown generator or agent, a missing settings or predictor file is one line, exit 2."""
     import subprocess
     import sys
 
@@ -77,7 +77,9 @@ def test_benchmark_agents_refuses_a_bad_setting_or_generator_in_one_line() -> No
     script = str(benchmarks_dir() / "bench_agents.py")
     for argv, msg in ((["--set", "bogus=1"], "unknown keyword"), (["--set", "grid_cell"], "expected KEY=VALUE"),
                       (["--generators", "nope"], "unknown ['nope']"),
-                      (["--agents", "frontier", "nope"], "--agents: unknown ['nope']")):  # fmt: skip
+                      (["--agents", "frontier", "nope"], "--agents: unknown ['nope']"),
+                      (["--predictive", "nope.toml"], "--predictive: path: no configuration file"),
+                      (["--predictor", "nope.pt"], "--predictor: no such file nope.pt")):  # fmt: skip
         out = subprocess.run([sys.executable, script, "--quick", *argv], capture_output=True, text=True)
         assert out.returncode == 2 and msg in out.stderr.splitlines()[-1], out.stderr[-400:]
 

@@ -18,6 +18,7 @@ from digslam.agents.prediction.fit import PredictorConfig, is_predictor_config  
 from digslam.agents.prediction.model import SHIPPED, load  # noqa: E402
 
 CONFIG = Path(__file__).resolve().parents[3] / "agents" / "configs" / "map_predictor.toml"
+BUILDINGS = CONFIG.with_name("map_predictor_buildings.toml")
 
 
 def _digslam(*args: str, cwd: Path) -> subprocess.CompletedProcess:
@@ -31,6 +32,20 @@ def test_the_shipped_config_is_a_predictor_config():
     assert cfg.epochs == 3 and cfg.kind == "map_predictor"
     with pytest.raises(ValueError, match="unknown"):
         PredictorConfig.from_file(CONFIG, ["epoch=3"])
+
+
+def test_the_shipped_weights_come_from_the_buildings_stage():
+    """Stage 2 (``map_predictor_buildings.toml``) fine-tunes stage 1 (``map_predictor.toml``) with the
+    floorplan training windows; the shipped sidecar holds the same settings."""
+    stage2 = PredictorConfig.from_file(BUILDINGS)
+    assert stage2.init == PredictorConfig.from_file(CONFIG).out_dir + "/map_predictor.pt"
+    assert "floorplan" in stage2.generators
+    assert "floorplan" not in PredictorConfig.from_file(CONFIG).generators
+    meta = json.loads(SHIPPED.with_suffix(".json").read_text())
+    same = ("generators", "train_levels", "val_levels", "episode_steps", "snapshot_every", "width", "epochs",
+            "batch_size", "lr", "clear_weight", "seed")  # fmt: skip
+    assert {k: meta["config"][k] for k in same} == {k: getattr(stage2, k) for k in same}
+    assert meta["epochs_done"] == stage2.epochs and meta["config"]["init"]
 
 
 def test_tiny_training_then_demo_and_evaluate(tmp_path):
